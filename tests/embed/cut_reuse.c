@@ -1,15 +1,21 @@
 /* What a cut takes over from the rules it extends, for a body given by its surface alone: the
  * body's volume in each whole cell (fcm_cell_rules' cell_mvol), the face polygons of the region
- * cells no new cut reaches (face_nfp, face_meta, face_x) and the rules of the cells it copies
- * (borrowed, copied once when gathered). A hollow ball with a hole in an 8 x 8 x 7 Hex8 grid,
- * with the stiffness on the mass space, cut in sequence by blades along the grid's planes (a
- * plane, rectangles that end inside cells, overlapping regions) and a tilted plane. Asserts
+ * cells no new cut reaches (face_nfp, face_meta, face_x), the volume of each cell's corner
+ * polyhedron (cell_volume: the cells whose rules a cut copies are not set up) and the rules of
+ * the cells it copies (borrowed, copied once when gathered). A hollow ball with a hole in an 8 x 8
+ * x 7 Hex8 grid, with the stiffness on the mass space, cut in sequence by blades along the grid's
+ * planes (a plane, rectangles that end inside cells, overlapping regions) and a tilted plane.
+ * Asserts
  * - after every cut, the rules equal those of the same cuts made from rules stripped of what
  *   they keep (every cell measured and split again): classes, fractions, pieces, their
- *   volumes, components, points, weights, flags, cut faces and links, bit for bit;
+ *   volumes, components, points, weights, flags, cut faces, links and the embedded volume,
+ *   bit for bit, and the kept cell volumes equal those measured again;
  * - the kept values are used: whole cells' volumes and face polygons are kept after the
  *   cuts, and cells that take them occur;
- * - a kept volume off by 1e-3 (the control) changes the next cut's rules;
+ * - a kept volume off by 1e-3 (the control) changes the next cut's rules, and a kept cell
+ *   volume off by 1e-3 its embedded volume;
+ * - the links equal those of the cut without its shortcuts (fcm__cell_rules_create_cut_keep()
+ *   with keep = 0: every region cell split for its face polygons, those without pieces too);
  * - the face overlaps' shortcut: every kept face polygon of a part the body fills (fmeta's
  *   flag), larger than 4 times the area threshold, is covered by the body by the prism's
  *   moments (fcm__material_on_face()), as the links take it without them; polygons of other
@@ -50,7 +56,9 @@ static void strip(fcm_cell_rules *r)
   fcm__free(ctx, r->face_meta);
   fcm__free(ctx, r->face_x);
   fcm__free(ctx, r->cell_mvol);
+  fcm__free(ctx, r->cell_volume);
   r->face_nfp = NULL, r->face_meta = NULL, r->face_x = NULL, r->cell_mvol = NULL;
+  r->cell_volume = NULL;
 }
 
 static int same_array(const void *a, const void *b, size_t bytes)
@@ -63,6 +71,7 @@ static int same_rules(const fcm_cell_rules *a, const fcm_cell_rules *b)
 {
   const fcm_index nc = a->num_cells, np = a->num_pieces;
   if (nc != b->num_cells || np != b->num_pieces || a->num_links != b->num_links) return 0;
+  if (memcmp(&a->stats.embedded_volume, &b->stats.embedded_volume, sizeof(double))) return 0;
   int same = same_array(a->cls, b->cls, (size_t)nc) &&
              same_array(a->fraction, b->fraction, (size_t)nc * sizeof(double)) &&
              same_array(a->piece_off, b->piece_off, (size_t)(nc + 1) * sizeof(fcm_index)) &&
@@ -163,7 +172,8 @@ int main(void)
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, surf, &o, &a));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, surf, &o, &b));
   long reused = 0, volumes = 0, faces = 0, full = 0, full_cov = 0, other = 0, other_open = 0;
-  int control_differs = 0;
+  int control_differs = 0, volume_control_differs = 0;
+  long volumes_kept = 0, volumes_wrong = 0;
   for (int k = 0; k < NCUT && a && b; k++) {
     /* the control: the next cut from a copy whose kept volumes are off by 1e-3 */
     if (k == 2 && a->cell_mvol) {
@@ -177,11 +187,34 @@ int main(void)
       ref = next_cut(mesh, surf, b, k);
       control_differs = wrong && ref && !same_rules(wrong, ref);
       fcm_cell_rules_destroy(&wrong);
+      /* the control of the cell volumes: the same, off by 1e-3 */
+      for (fcm_index c = 0; a->cell_volume && c < a->num_cells; c++)
+        a->cell_volume[c] *= 1.0 + 1e-3;
+      wrong = next_cut(mesh, surf, a, k);
+      for (fcm_index c = 0; a->cell_volume && c < a->num_cells; c++)
+        a->cell_volume[c] /= 1.0 + 1e-3;
+      volume_control_differs = wrong && ref && !same_rules(wrong, ref);
+      fcm_cell_rules_destroy(&wrong);
       fcm_cell_rules_destroy(&ref);
     }
     for (fcm_index c = 0; a->face_nfp && c < a->num_cells; c++)
       reused += a->face_nfp[c] >= 0 && a->reached && !a->reached[c];
+    for (fcm_index c = 0; k > 0 && a->cell_volume && c < a->num_cells; c++)
+      volumes_kept += !isnan(a->cell_volume[c]);
+    fcm_cell_rules *plain = NULL;
+    {
+      fcm_surface *ps = NULL;
+      const blade *bl = blades + k;
+      TEST_OK(ctx, fcm_surface_create_plane(ctx, bl->p, bl->n, bl->lo, bl->hi, &ps));
+      if (ps) TEST_OK(ctx, fcm__cell_rules_create_cut_keep(ctx, mesh, surf, a, ps, 0, &plain));
+      fcm_surface_destroy(&ps);
+    }
     fcm_cell_rules *na = next_cut(mesh, surf, a, k);
+    const int same_links_plain =
+        plain && na && plain->num_links == na->num_links &&
+        same_array(plain->links, na->links, 2 * (size_t)na->num_links * sizeof(fcm_index));
+    fcm_cell_rules_destroy(&plain);
+    TEST_TRUE(same_links_plain);
     strip(b);
     fcm_cell_rules *nb = next_cut(mesh, surf, b, k);
     fcm_cell_rules_destroy(&a);
@@ -191,6 +224,10 @@ int main(void)
     const int same = same_rules(a, b);
     long v = 0, f = 0;
     for (fcm_index c = 0; c < a->num_cells; c++) {
+      /* a kept cell volume is the one measured again (b measures every cell) */
+      if (a->cell_volume && !isnan(a->cell_volume[c]))
+        volumes_wrong +=
+            !b->cell_volume || memcmp(a->cell_volume + c, b->cell_volume + c, sizeof(double)) != 0;
       v += a->cell_mvol && isfinite(a->cell_mvol[c]);
       f += a->face_nfp && a->face_nfp[c] >= 0;
     }
@@ -206,12 +243,16 @@ int main(void)
     printf("cells that may take kept face polygons: %ld; the control (volumes off by 1e-3) "
            "changes the rules: %s\n",
            reused, control_differs ? "yes" : "NO");
+    printf("cell volumes kept before cuts 2 to %d: %ld (%ld not those measured again); the "
+           "control (off by 1e-3) changes the embedded volume: %s\n",
+           NCUT, volumes_kept, volumes_wrong, volume_control_differs ? "yes" : "NO");
     printf("kept face polygons of filled parts: %ld, covered by the prism's moments: %ld; of "
            "other parts: %ld, not covered: %ld\n",
            full, full_cov, other, other_open);
   }
   TEST_TRUE(volumes > 0 && faces > 0 && reused > 0);
   TEST_TRUE(control_differs);
+  TEST_TRUE(volumes_kept > 0 && volumes_wrong == 0 && volume_control_differs);
   TEST_TRUE(full > 0 && full_cov == full && other_open > 0);
   fcm_cell_rules_destroy(&a);
   fcm_cell_rules_destroy(&b);

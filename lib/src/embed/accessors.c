@@ -48,6 +48,7 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   fcm__free(ctx, R->links);
   fcm__free(ctx, R->reached);
   fcm__free(ctx, R->cell_mvol);
+  fcm__free(ctx, R->cell_volume);
   for (fcm_index c = 0; R->face_meta && R->face_x && c < R->num_cells; c++) {
     fcm__free(ctx, R->face_meta[c]);
     fcm__free(ctx, R->face_x[c]);

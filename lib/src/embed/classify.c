@@ -383,12 +383,18 @@ static fcm_status copy_prev_cell(const build *B, fcm_cell_rules *R, fcm_index c,
   fcm_ctx *ctx = B->ctx;
   const fcm_cell_rules_options *opt = B->o;
   fcm__embed_cell cell;
-  /* a cell whose rules are copied needs its volume only, but a dropped one its surface share
-   * where surface rules are built */
-  if (!(own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule))
-    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
-  else
+  double *known = R->cell_volume ? R->cell_volume + c : NULL; /* one writer per cell */
+  /* a cell whose rules are copied needs its volume only (kept from an earlier cut), but a
+   * dropped one its surface share where surface rules are built */
+  if (own && B->prev->cls[c] == FCM_CELL_DROPPED && B->tri_rule) {
     FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  } else if (known && !isnan(*known)) {
+    cell.id = c;
+    cell.volume = *known;
+  } else {
+    FCM_TRY(ctx, fcm__embed_cell_setup_volume(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  }
+  if (known) *known = cell.volume;
   FCM_TRY(ctx, keep_cell(B, R, &cell, o));
   if (kept_faces)
     FCM_TRY(ctx, fcm__embed_copy_face_polygons(ctx, B->prev, c, &o->fmeta, &o->fx, &o->nfp));
@@ -415,13 +421,19 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const int integrate = !B->rebuild || B->rebuild[c];
   const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
   double sbox[6];
-  const int no_work = !integrate && (!B->region[c] || (B->same_links && B->same_links[c]));
+  /* a cell the new cut does not reach needs no work outside the region, where its links with
+   * every region neighbour are kept, or where it has no pieces (the links skip such a cell: its
+   * face polygons would be read by no cut until one reaches it and makes them again) */
+  const int no_work =
+      !integrate && (!B->region[c] || (B->same_links && B->same_links[c]) ||
+                     (B->keep && B->prev && B->prev->piece_off[c + 1] == B->prev->piece_off[c]));
   /* a region cell the new cut does not reach, with the face polygons the earlier cut kept */
   const int kept_faces =
       !integrate && !no_work && B->keep && B->prev->face_nfp && B->prev->face_nfp[c] >= 0;
   if (no_work || kept_faces) return copy_prev_cell(B, R, c, own, kept_faces, ws, o);
   const double t0 = fcm_wtime();
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
+  if (R->cell_volume) R->cell_volume[c] = cell.volume;
   if (B->prev) FCM_TRY(ctx, fcm__embed_check_convex(ctx, B->mesh, c, opt));
   int surface = B->surface && cell.affine && !(B->cut_tree && B->region[c]);
   if (surface && opt->moments == FCM_CELL_MOMENTS_AUTO && B->geom->num_cells > 0) {
@@ -524,6 +536,38 @@ cleanup:
   return st;
 }
 
+/* One cell of fcm__embed_run_cells() on the calling thread (its workspace *ws made by its
+ * first cell), with the progress report. */
+static void run_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_ws **ws,
+                     cell_out *out, cell_sums *mine, fcm__loop *loop,
+                     const fcm_cell_rules_options *opt, fcm_index *done, double *last)
+{
+  fcm_ctx *ctx = B->ctx;
+  const fcm_index nc = R->num_cells;
+  if (fcm__loop_skip(loop, c)) return;
+  fcm__loop_iter it;
+  fcm__loop_enter(loop, &it, c);
+  fcm_status s = FCM_OK;
+  if (!*ws) { /* the thread's workspace, made by its first cell */
+    *ws = fcm__calloc(ctx, 1, sizeof **ws);
+    if (!*ws) s = FCM_ERR_ALLOC;
+  }
+  const int remote = B->remote && B->remote[c]; /* classified by another process */
+  if (s == FCM_OK && !remote) s = process_cell(B, R, c, *ws, out + c, mine);
+  fcm__loop_leave(loop, &it, s);
+  if (opt->progress) { /* counted by all threads, reported by the calling one */
+#pragma omp atomic
+    (*done)++;
+    if (omp_get_thread_num() == 0 && fcm_wtime() - *last >= opt->progress_interval) {
+      fcm_index now;
+#pragma omp atomic read
+      now = *done;
+      opt->progress(now, nc, opt->progress_user);
+      *last = fcm_wtime();
+    }
+  }
+}
+
 /* Phase 2: every cell in parallel into its own cell_out; thread sums into *sums. An error
  * is that of the lowest failing cell, whatever the thread count. */
 fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
@@ -532,17 +576,20 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   const fcm_index nc = R->num_cells;
-  fcm_index done = 0;
+  fcm_index done = 0, first = nc;
   double last = fcm_wtime();
   fcm__loop loop;
   fcm_index *order = NULL; /* a cut: the cells it integrates again first (the threads' shares
-                              end together), then the others; each cell's work is its own */
+                              end together), one at a time, then the others, whose rules are
+                              copied, in chunks (one cell is less work than taking it) */
   if (B->rebuild) {
     FCM_ALLOC(ctx, (size_t)nc + 1, order);
     fcm_index n = 0;
-    for (int pass = 0; pass < 2; pass++)
+    for (int pass = 0; pass < 2; pass++) {
       for (fcm_index c = 0; c < nc; c++)
         if ((B->rebuild[c] != 0) == (pass == 0)) order[n++] = c;
+      if (pass == 0) first = n;
+    }
   }
   fcm__loop_begin(ctx, &loop);
   memset(sums, 0, sizeof *sums);
@@ -556,32 +603,12 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
     cell_sums mine;
     memset(&mine, 0, sizeof mine);
     fcm__embed_ws *ws = NULL;
-#pragma omp for schedule(dynamic, 1)
-    for (fcm_index i = 0; i < nc; i++) {
-      const fcm_index c = order ? order[i] : i;
-      if (fcm__loop_skip(&loop, c)) continue;
-      fcm__loop_iter it;
-      fcm__loop_enter(&loop, &it, c);
-      fcm_status s = FCM_OK;
-      if (!ws) { /* the thread's workspace, made by its first cell */
-        ws = fcm__calloc(ctx, 1, sizeof *ws);
-        if (!ws) s = FCM_ERR_ALLOC;
-      }
-      const int remote = B->remote && B->remote[c]; /* classified by another process */
-      if (s == FCM_OK && !remote) s = process_cell(B, R, c, ws, out + c, &mine);
-      fcm__loop_leave(&loop, &it, s);
-      if (opt->progress) { /* counted by all threads, reported by the calling one */
-#pragma omp atomic
-        done++;
-        if (omp_get_thread_num() == 0 && fcm_wtime() - last >= opt->progress_interval) {
-          fcm_index now;
-#pragma omp atomic read
-          now = done;
-          opt->progress(now, nc, opt->progress_user);
-          last = fcm_wtime();
-        }
-      }
-    }
+#pragma omp for schedule(dynamic, 1) nowait
+    for (fcm_index i = 0; i < first; i++)
+      run_cell(B, R, order ? order[i] : i, &ws, out, &mine, &loop, opt, &done, &last);
+#pragma omp for schedule(dynamic, 64)
+    for (fcm_index i = first; i < nc; i++)
+      run_cell(B, R, order[i], &ws, out, &mine, &loop, opt, &done, &last);
     if (ws) fcm__embed_ws_free(ctx, ws);
     fcm__free(ctx, ws);
 #pragma omp critical(fcm_embed_sum)

@@ -233,6 +233,11 @@ fcm_status fcm__embed_cut_setup(build *B, fcm_cell_rules *R, fcm_index first_new
       R->cell_mvol[c] = B->prev && B->prev->cell_mvol ? B->prev->cell_mvol[c] : NAN;
     B->cell_mvol = R->cell_mvol;
   }
+  fcm__free(ctx, R->cell_volume);
+  R->cell_volume = NULL;
+  FCM_ALLOC(ctx, (size_t)nc + 1, R->cell_volume);
+  for (fcm_index c = 0; c < nc; c++)
+    R->cell_volume[c] = B->prev && B->prev->cell_volume ? B->prev->cell_volume[c] : NAN;
   if (B->prev && first_new > 0) FCM_ALLOC(ctx, (size_t)nc + 1, B->prev_region);
   FCM_TRY(ctx, reached_cells(B, first_new, R->reached));
   for (fcm_index c = 0; c < nc; c++) {
@@ -412,7 +417,7 @@ static fcm_status cell_links(const build *B, const fcm_cell_rules *R, const cell
   const int nf = fcm_mesh_get_element_info(mesh)->num_faces;
   const fcm_index *nbr = fcm_mesh_neighbors(mesh);
   fcm__embed_cell cell;
-  FCM_TRY(B->ctx, fcm__embed_cell_setup(B->ctx, mesh, c, B->o->clip_rtol, &cell));
+  int set_up = 0; /* the cell is set up for the first pair whose links are not kept */
   for (int f = 0; f < nf; f++) {
     const fcm_index c2 = nbr[(size_t)nf * c + f];
     if (c2 <= c || !B->region[c2] || out[c2].np == 0) continue;
@@ -420,6 +425,12 @@ static fcm_status cell_links(const build *B, const fcm_cell_rules *R, const cell
     while (f2 < nf && nbr[(size_t)nf * c2 + f2] != c)
       f2++;
     if (f2 == nf) continue;
+    if (links_kept(B, c, c2)) {
+      FCM_TRY(B->ctx, copy_links(B, R, c, c2, links, nl, cap));
+      continue;
+    }
+    if (!set_up) FCM_TRY(B->ctx, fcm__embed_cell_setup(B->ctx, mesh, c, B->o->clip_rtol, &cell));
+    set_up = 1;
     FCM_TRY(B->ctx, face_links(B, R, out, &cell, c, f, c2, f2, mat, tc, links, nl, cap));
   }
 cleanup:

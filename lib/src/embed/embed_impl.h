@@ -81,6 +81,10 @@ struct fcm_cell_rules {
    * cells' split measures it (fcm__parts' whole_mvol), kept from cut to cut; NaN where not
    * measured yet (NULL without cuts). */
   double *cell_mvol;
+  /* cell_volume[c]: the volume of cell c's corner polyhedron (fcm__embed_cell's volume), kept
+   * from cut to cut so that a cell whose rules a cut copies needs no set-up; NaN where no cut
+   * set the cell up yet (NULL without cuts). */
+  double *cell_volume;
   /* face_nfp[c] >= 0: cell c's face polygons (face_meta[c], FCM__EMBED_FMETA ints each, and
    * face_x[c]: fcm__parts' fmeta and fx) made from the cuts' triangles that reach it in one
    * pass, as a cut that does not reach it makes them again; -1: none kept (NULL without

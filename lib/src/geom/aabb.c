@@ -122,6 +122,10 @@ fcm_status fcm_aabb_tree_create(fcm_ctx *ctx, fcm_index n, const double *boxes,
   if (n > 0) {
     t->num_nodes = 1;
     build(t, 0, 0, n);
+    /* the boxes in slot order too: a leaf's are contiguous */
+    FCM_ALLOC(ctx, 6 * (size_t)n, t->slot_boxes);
+    for (fcm_index s = 0; s < n; s++)
+      memcpy(t->slot_boxes + 6 * s, t->boxes + 6 * t->perm[s], 6 * sizeof(double));
   }
   *tree = t;
   t = NULL;
@@ -137,6 +141,7 @@ void fcm_aabb_tree_destroy(fcm_aabb_tree **tree)
   fcm__free(t->ctx, t->nodes);
   fcm__free(t->ctx, t->perm);
   fcm__free(t->ctx, t->boxes);
+  fcm__free(t->ctx, t->slot_boxes);
   fcm__free(t->ctx, t);
   *tree = NULL;
 }
@@ -163,9 +168,9 @@ typedef struct probe {
 
 /* The segment's slab test with plain comparisons (fmin and fmax are library calls here, and
  * a segment query visits many nodes): no operand is NaN, so the result is theirs. */
-static int probe_meets(const probe *q, const double *blo, const double *bhi)
+static inline int probe_meets(const probe *q, const double *blo, const double *bhi, int segment)
 {
-  if (!q->segment) return overlaps(blo, bhi, q->lo, q->hi);
+  if (!segment) return overlaps(blo, bhi, q->lo, q->hi);
   double t0 = 0.0, t1 = 1.0;
   for (int k = 0; k < 3; k++) {
     const double lo = blo[k] - q->pad, hi = bhi[k] + q->pad;
@@ -182,41 +187,104 @@ static int probe_meets(const probe *q, const double *blo, const double *bhi)
   return 1;
 }
 
-static fcm_status traverse(fcm_ctx *ctx, const fcm_aabb_tree *t, const probe *q, fcm__idbuf *buf)
+/* ids[0..n) ascending by insertion (few ids). */
+static void insertion_sort(fcm_index *ids, size_t n)
+{
+  for (size_t i = 1; i < n; i++) {
+    const fcm_index v = ids[i];
+    size_t j = i;
+    for (; j > 0 && ids[j - 1] > v; j--)
+      ids[j] = ids[j - 1];
+    ids[j] = v;
+  }
+}
+
+/* The ids ascending (distinct ids: any sort gives the same order), without qsort's call per
+ * comparison: a quicksort on the median of three, insertion below 24 ids, qsort for a range
+ * that went deeper than twice log2 n (no quadratic case). */
+static void sort_ids(fcm_index *ids, size_t n)
+{
+  int limit = 0;
+  for (size_t m = n; m > 1; m >>= 1)
+    limit += 2;
+  while (n > 24) {
+    if (limit-- == 0) {
+      qsort(ids, n, sizeof *ids, cmp_index);
+      return;
+    }
+    fcm_index *a = ids, *m = ids + n / 2, *z = ids + n - 1, t;
+    if (*m < *a) t = *m, *m = *a, *a = t;
+    if (*z < *m) {
+      t = *z, *z = *m, *m = t;
+      if (*m < *a) t = *m, *m = *a, *a = t;
+    }
+    const fcm_index piv = *m;
+    size_t i = 0, j = n - 1;
+    for (;;) { /* Hoare: [0, j] <= piv <= [j + 1, n) */
+      while (ids[i] < piv)
+        i++;
+      while (ids[j] > piv)
+        j--;
+      if (i >= j) break;
+      t = ids[i], ids[i] = ids[j], ids[j] = t;
+      i++, j--;
+    }
+    const size_t left = j + 1; /* the smaller side recursively, the larger in the loop */
+    if (left < n - left) {
+      sort_ids(ids, left);
+      ids += left, n -= left;
+    } else {
+      sort_ids(ids + left, n - left);
+      n = left;
+    }
+  }
+  insertion_sort(ids, n);
+}
+
+/* The items whose boxes q meets, ascending, into buf. Children are tested before they are
+ * pushed, and a leaf's boxes are read in slot order (t->slot_boxes); the set found,
+ * sorted, does not depend on the order of the visit. segment: q->segment, a constant at each
+ * call so that the test is not chosen per box. */
+static inline fcm_status traverse_probe(fcm_ctx *ctx, const fcm_aabb_tree *t, const probe *q,
+                                        fcm__idbuf *buf, int segment)
 {
   fcm_status st = FCM_OK;
   fcm_index stack[MAX_DEPTH];
   int top = 0;
   buf->n = 0;
-  if (t->num_items == 0) goto cleanup;
+  if (t->num_items == 0 || !probe_meets(q, t->nodes[0].lo, t->nodes[0].hi, segment)) goto cleanup;
   stack[top++] = 0;
   while (top > 0) {
     const fcm__aabb_node *nd = t->nodes + stack[--top];
-    if (!probe_meets(q, nd->lo, nd->hi)) continue;
     if (nd->count == 0) {
       FCM_CHECK(top + 2 <= MAX_DEPTH, ctx, FCM_ERR_INTERNAL, "aabb tree: depth exceeds %d",
                 MAX_DEPTH);
-      stack[top++] = nd->first + 1;
-      stack[top++] = nd->first;
+      const fcm__aabb_node *l = t->nodes + nd->first;
+      if (probe_meets(q, l[1].lo, l[1].hi, segment)) stack[top++] = nd->first + 1;
+      if (probe_meets(q, l[0].lo, l[0].hi, segment)) stack[top++] = nd->first;
       continue;
     }
-    for (fcm_index s = nd->first; s < nd->first + nd->count; s++) {
-      const fcm_index id = t->perm[s];
-      const double *b = t->boxes + 6 * id;
-      if (!probe_meets(q, b, b + 3)) continue;
-      if (buf->n == buf->cap) {
-        const size_t cap = buf->cap ? 2 * buf->cap : 64;
-        void *grown = buf->ids;
-        FCM_TRY(ctx, fcm__resize(ctx, &grown, buf->cap, cap, sizeof *buf->ids));
-        buf->ids = grown;
-        buf->cap = cap;
-      }
-      buf->ids[buf->n++] = id;
+    if (buf->n + (size_t)nd->count > buf->cap) {
+      size_t cap = buf->cap ? 2 * buf->cap : 64;
+      while (cap < buf->n + (size_t)nd->count)
+        cap *= 2;
+      void *grown = buf->ids;
+      FCM_TRY(ctx, fcm__resize(ctx, &grown, buf->cap, cap, sizeof *buf->ids));
+      buf->ids = grown;
+      buf->cap = cap;
     }
+    const double *b = t->slot_boxes + 6 * nd->first;
+    for (fcm_index s = nd->first; s < nd->first + nd->count; s++, b += 6)
+      if (probe_meets(q, b, b + 3, segment)) buf->ids[buf->n++] = t->perm[s];
   }
-  if (buf->n > 1) qsort(buf->ids, buf->n, sizeof *buf->ids, cmp_index);
+  sort_ids(buf->ids, buf->n);
 cleanup:
   return st;
+}
+
+static fcm_status traverse(fcm_ctx *ctx, const fcm_aabb_tree *t, const probe *q, fcm__idbuf *buf)
+{
+  return q->segment ? traverse_probe(ctx, t, q, buf, 1) : traverse_probe(ctx, t, q, buf, 0);
 }
 
 fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *t, const double lo[3],

@@ -90,6 +90,7 @@ struct fcm_aabb_tree {
   fcm__aabb_node *nodes; /* node 0 is the root (absent when num_items == 0) */
   fcm_index *perm;       /* item ids, leaves own contiguous ranges */
   double *boxes;         /* num_items x 6 copy: lo[3], hi[3] */
+  double *slot_boxes;    /* the same in slot order (box s is that of item perm[s]) */
 };
 
 /* Growable id buffer for queries from many threads (one buffer per thread). */
