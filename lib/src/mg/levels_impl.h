@@ -226,6 +226,10 @@ static inline __attribute__((always_inline)) void fcm__mg_row_dot3(const double 
  * whole nodes too (FCM__MG_TRIPLE_NODES, fcm__mg_row_dot3()'s nodes). */
 #define FCM__MG_TRIPLE       1
 #define FCM__MG_TRIPLE_NODES 2
+/* the flags are the block smoothers' hints to fcm__schwarz_create_blocks_pattern() */
+_Static_assert(FCM__MG_TRIPLE == FCM__SCHWARZ_ROWS_SAME &&
+                   FCM__MG_TRIPLE_NODES == FCM__SCHWARZ_ROWS_NODES,
+               "row flags");
 
 /* Whether rows i, i + 1, i + 2 may be summed by fcm__mg_row_dot3() (triple: the level's row
  * order's flags, NULL: none may). */

@@ -670,9 +670,12 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
     if (nb > 0 && old && same[l])
       FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
     if (nb > 0 && !kept) {
-      FCM_TRY(ctx,
-              (m->values_pending ? fcm__schwarz_create_blocks_pattern : fcm__schwarz_create_blocks)(
-                  ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
+      if (m->values_pending) /* the row order's flags spare the scans' comparisons */
+        FCM_TRY(ctx, fcm__schwarz_create_blocks_pattern(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs,
+                                                        L->rows.triple, &L->blk));
+      else
+        FCM_TRY(ctx,
+                fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
       FCM_TRY(ctx, block_slabs(m, L));
     }
     FCM_FREE(ctx, ptr);

@@ -43,9 +43,11 @@ struct fcm_schwarz {
   double *S;             /* S_K: m x m each (symmetric); a block smoother's (blocks_only) the
                             lower triangle packed by rows (FCM__SCHWARZ_PACKED) */
   size_t *pos_off;       /* num_blocks + 1 offsets into pos */
-  int *pos;              /* m x m each: where C_K's entry (i, j) lies in C's row dofs[i] (-1:
-                            none) */
-  unsigned char *full;   /* num_blocks: every entry of C_K is stored (pos holds them all) */
+  int *pos;              /* m (m + 1) / 2 each, packed by rows (FCM__SCHWARZ_PACKED(i, j),
+                            j <= i): where C_K's entry (i, j) lies in C's row dofs[i] (-1:
+                            none); the lower triangle is all the gathers read */
+  unsigned char *full;   /* num_blocks: every entry of C_K's lower triangle is stored (pos
+                            holds them all) */
   unsigned char *factor; /* blocks_only, num_blocks: S's slot holds X = L^{-1} of the Cholesky
                             factor C_K = L L^T (its lower triangle), S_K = X^T X */
   int max_m;
@@ -169,7 +171,8 @@ typedef struct block_stats {
 /* Gather C_K = R_K C R_K^T into a (m x m, column-major) by scanning the block rows: each
  * block row's matrix row is read once, its columns found through loc (DOF -> block index + 1,
  * zero outside the block, left zero on return). Records where each entry lies in its row
- * (pos, m x m row-major, -1: not stored) and returns whether all are stored in *full.
+ * (pos, its lower triangle packed by rows, -1: not stored) and returns whether all of the
+ * lower triangle is stored in *full.
  * 0 when an entry is NaN or infinite. vals and a NULL: the positions from C's pattern only. */
 static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_index *d, int *loc,
                        int *pos, unsigned char *full, double *a)
@@ -178,11 +181,12 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
   const int *ci = fcm_csr_col_idx(C);
   int finite = 1, stored = 0;
   if (a) memset(a, 0, sizeof *a * (size_t)m * (size_t)m);
-  for (size_t e = 0; e < (size_t)m * (size_t)m; e++)
+  for (size_t e = 0; e < FCM__SCHWARZ_PACKED(m, 0); e++)
     pos[e] = -1;
   for (int j = 0; j < m; j++)
     loc[d[j]] = j + 1;
-  for (int i = 0; i < m; i++)
+  for (int i = 0; i < m; i++) {
+    int *row = pos + FCM__SCHWARZ_PACKED(i, 0);
     for (fcm_index p = rp[d[i]]; p < rp[d[i] + 1]; p++) {
       const int k = loc[ci[p]];
       if (!k) continue;
@@ -190,12 +194,14 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
         if (k - 1 <= i) finite &= isfinite(vals[p]) != 0;
         a[i + (size_t)(k - 1) * m] = vals[p];
       }
-      if (pos[(size_t)i * m + k - 1] < 0) stored++;
-      pos[(size_t)i * m + k - 1] = (int)(p - rp[d[i]]);
+      if (k - 1 > i) continue;
+      if (row[k - 1] < 0) stored++;
+      row[k - 1] = (int)(p - rp[d[i]]);
     }
+  }
   for (int j = 0; j < m; j++)
     loc[d[j]] = 0;
-  *full = stored == m * m;
+  *full = (size_t)stored == FCM__SCHWARZ_PACKED(m, 0);
   return finite;
 }
 
@@ -211,7 +217,7 @@ static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_i
   int finite = 1;
   for (int i = 0; i < m; i++) {
     const fcm_index r0 = rp[d[i]], len = rp[d[i] + 1] - r0;
-    const int *pi = pos + (size_t)i * m;
+    const int *pi = pos + FCM__SCHWARZ_PACKED(i, 0);
     for (int j = 0; j <= i; j++) {
       const fcm_index p = r0 + pi[j];
       if (pi[j] >= len || ci[p] != d[j]) return -1;
@@ -652,50 +658,83 @@ cleanup:
   return st;
 }
 
-/* gather_scan()'s positions (pos, *full) from C's pattern alone. Where block rows i, i + 1,
- * i + 2 are a node's three DOFs (d[i] = 3 k, d[i + 1] = 3 k + 1, d[i + 2] = 3 k + 2) and C's
- * three rows hold one pattern, rows i + 1 and i + 2 of pos are row i's (a position is counted
- * from its row's start): the scan reads row i only. */
-static void scan_pattern(const fcm_csr *C, int m, const fcm_index *d, int *loc, int *pos,
-                         unsigned char *full)
+/* Do block rows i, i + 1, i + 2 hold a node's three DOFs (d[i] = 3 k, d[i + 1] = 3 k + 1,
+ * d[i + 2] = 3 k + 2) whose rows of C share one pattern (tri: C's rows' flags,
+ * FCM__SCHWARZ_ROWS_SAME at 3 k, or NULL: compared here)? */
+static int rows_triple(const fcm_index *rp, const int *ci, const unsigned char *tri, int m,
+                       const fcm_index *d, int i)
+{
+  const fcm_index r = d[i];
+  if (r % 3 != 0 || i + 2 >= m || d[i + 1] != r + 1 || d[i + 2] != r + 2) return 0;
+  if (tri) return tri[r] != 0;
+  const fcm_index len = rp[r + 1] - rp[r];
+  return rp[r + 2] - rp[r + 1] == len && rp[r + 3] - rp[r + 2] == len &&
+         !memcmp(ci + rp[r], ci + rp[r + 1], sizeof *ci * (size_t)len) &&
+         !memcmp(ci + rp[r], ci + rp[r + 2], sizeof *ci * (size_t)len);
+}
+
+/* Row r's positions of the block's columns 0 .. last into row (-1 where none; loc: DOF ->
+ * block column + 1); cnt[t]: those new in columns 0 .. i + t. Where the row's columns come in
+ * whole nodes and so do the block's DOFs (nodes), one look-up a node: a node's first DOF
+ * outside the block has its other two outside too, and inside, they follow it. */
+static void scan_row(const fcm_index *rp, const int *ci, fcm_index r, const int *loc, int nodes,
+                     int i, int last, int *row, size_t cnt[3])
+{
+  const int step = nodes ? 3 : 1;
+  for (fcm_index p = rp[r]; p < rp[r + 1]; p += step) {
+    const int k = loc[ci[p]];
+    if (!k) continue;
+    for (int c = 0; c < step && k - 1 + c <= last; c++) {
+      const int j = k - 1 + c;
+      if (row[j] < 0)
+        for (int t = FCM_MAX(j - i, 0); t < 3; t++)
+          cnt[t]++;
+      row[j] = (int)(p + c - rp[r]);
+    }
+  }
+}
+
+/* gather_scan()'s positions (pos, *full) from C's pattern alone (tri: C's rows' flags, or
+ * NULL). Where rows i, i + 1, i + 2 are a node's three (rows_triple()), rows i + 1 and i + 2
+ * of pos begin with row i's (a position is counted from its row's start): row i is read once,
+ * to the block's column i + 2, into packed row i + 2, whose beginnings rows i and i + 1 take. */
+static void scan_pattern(const fcm_csr *C, const unsigned char *tri, int m, const fcm_index *d,
+                         int *loc, int *pos, unsigned char *full)
 {
   const fcm_index *rp = fcm_csr_row_ptr(C);
   const int *ci = fcm_csr_col_idx(C);
-  int stored = 0;
-  for (size_t e = 0; e < (size_t)m * (size_t)m; e++)
+  size_t stored = 0;
+  int whole = tri && m % 3 == 0; /* the block's DOFs come in whole nodes */
+  for (int j = 0; whole && j < m; j += 3)
+    whole = d[j] % 3 == 0 && d[j + 1] == d[j] + 1 && d[j + 2] == d[j] + 2;
+  for (size_t e = 0; e < FCM__SCHWARZ_PACKED(m, 0); e++)
     pos[e] = -1;
   for (int j = 0; j < m; j++)
     loc[d[j]] = j + 1;
   for (int i = 0; i < m; i++) {
-    int *row = pos + (size_t)i * m, cnt = 0;
-    const fcm_index r = d[i], len = rp[r + 1] - rp[r];
-    for (fcm_index p = rp[r]; p < rp[r + 1]; p++) {
-      const int k = loc[ci[p]];
-      if (!k) continue;
-      cnt += row[k - 1] < 0;
-      row[k - 1] = (int)(p - rp[r]);
-    }
-    stored += cnt;
-    if (r % 3 == 0 && i + 2 < m && d[i + 1] == r + 1 && d[i + 2] == r + 2 &&
-        rp[r + 2] - rp[r + 1] == len && rp[r + 3] - rp[r + 2] == len &&
-        !memcmp(ci + rp[r], ci + rp[r + 1], sizeof *ci * (size_t)len) &&
-        !memcmp(ci + rp[r], ci + rp[r + 2], sizeof *ci * (size_t)len)) {
-      memcpy(row + m, row, sizeof *row * (size_t)m);
-      memcpy(row + 2 * m, row, sizeof *row * (size_t)m);
-      stored += 2 * cnt;
+    const int triple = rows_triple(rp, ci, tri, m, d, i), last = triple ? i + 2 : i;
+    const int nodes = whole && triple && tri[d[i]] == FCM__SCHWARZ_ROWS_NODES;
+    int *row = pos + FCM__SCHWARZ_PACKED(last, 0);
+    size_t cnt[3] = {0, 0, 0}; /* stored in rows i, i + 1, i + 2 */
+    scan_row(rp, ci, d[i], loc, nodes, i, last, row, cnt);
+    stored += cnt[0];
+    if (triple) {
+      memcpy(pos + FCM__SCHWARZ_PACKED(i, 0), row, sizeof *row * (size_t)(i + 1));
+      memcpy(pos + FCM__SCHWARZ_PACKED(i + 1, 0), row, sizeof *row * (size_t)(i + 2));
+      stored += cnt[1] + cnt[2];
       i += 2;
     }
   }
   for (int j = 0; j < m; j++)
     loc[d[j]] = 0;
-  *full = stored == m * m;
+  *full = stored == FCM__SCHWARZ_PACKED(m, 0);
 }
 
 /* The positions of every block's entries in C's rows, as gather_scan() finds them, from C's
  * pattern alone (a creation without values): the first setup gathers the blocks whose entries
  * are all stored through them (the same values as a scan), and scans the others. Blocks shared
  * by the threads, each with its DOF map (zero between blocks). */
-static void scan_positions(fcm_schwarz *P, const fcm_csr *C)
+static void scan_positions(fcm_schwarz *P, const fcm_csr *C, const unsigned char *tri)
 {
   const fcm_index nb = P->num_blocks;
 #pragma omp parallel num_threads(P->nt) if (P->nt > 1 && nb > SCAN_PARALLEL_BLOCKS)
@@ -703,8 +742,8 @@ static void scan_positions(fcm_schwarz *P, const fcm_csr *C)
     int *loc = P->loc + (size_t)P->n * (size_t)omp_get_thread_num();
 #pragma omp for schedule(dynamic, 64)
     for (fcm_index b = 0; b < nb; b++)
-      scan_pattern(C, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b], loc,
-                   P->pos + P->pos_off[b], &P->full[b]);
+      scan_pattern(C, tri, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b],
+                   loc, P->pos + P->pos_off[b], &P->full[b]);
   }
 }
 
@@ -713,7 +752,7 @@ static void scan_positions(fcm_schwarz *P, const fcm_csr *C)
 static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                          const fcm_index *block_ptr, const fcm_index *block_dofs,
                          const fcm_schwarz_options *opts, int blocks_only, int values_later,
-                         fcm_schwarz **out)
+                         const unsigned char *tri, fcm_schwarz **out)
 {
   fcm_status st = FCM_OK;
   fcm_schwarz *P = NULL;
@@ -779,7 +818,7 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
     P->block_ptr[b + 1] = block_ptr[b + 1];
     P->s_off[b + 1] =
         P->s_off[b] + (blocks_only ? FCM__SCHWARZ_PACKED(m, 0) : (size_t)m * (size_t)m);
-    P->pos_off[b + 1] = P->pos_off[b] + (size_t)m * (size_t)m;
+    P->pos_off[b + 1] = P->pos_off[b] + FCM__SCHWARZ_PACKED(m, 0);
   }
   for (fcm_index p = 0; p < total; p++) {
     P->dofs[p] = block_dofs[p];
@@ -823,7 +862,7 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   for (fcm_index i = 0; i < nr; i++)
     P->info.outside_dofs += !P->inside[i];
   if (values_later)
-    scan_positions(P, C);
+    scan_positions(P, C, tri);
   else
     FCM_TRY(ctx, fcm_schwarz_setup(P, C));
   *out = P;
@@ -838,21 +877,22 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
                               const fcm_index *block_ptr, const fcm_index *block_dofs,
                               const fcm_schwarz_options *opts, fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, 0, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, 0, NULL, out);
 }
 
 fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                       const fcm_index *block_ptr, const fcm_index *block_dofs,
                                       fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 0, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 0, NULL, out);
 }
 
 fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                               const fcm_index *block_ptr,
-                                              const fcm_index *block_dofs, fcm_schwarz **out)
+                                              const fcm_index *block_dofs,
+                                              const unsigned char *row_triple, fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 1, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 1, row_triple, out);
 }
 
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)

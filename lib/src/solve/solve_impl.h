@@ -42,9 +42,15 @@ fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index 
                                       fcm_schwarz **out);
 /* fcm__schwarz_create_blocks() without its set-up: C's pattern alone is read (the blocks'
  * positions in C's rows are found from it); the first fcm_schwarz_setup() sets up the values,
- * with the bits the creation's set-up gives. */
+ * with the bits the creation's set-up gives. row_triple (NULL: found from C): per row 3 k,
+ * FCM__SCHWARZ_ROWS_SAME when rows 3 k, 3 k + 1, 3 k + 2 hold one pattern,
+ * FCM__SCHWARZ_ROWS_NODES when its columns come in whole nodes too (3 G, 3 G + 1, 3 G + 2 one
+ * after the other), 0 otherwise (a shortcut not taken: the positions are the same). */
+#define FCM__SCHWARZ_ROWS_SAME  1
+#define FCM__SCHWARZ_ROWS_NODES 2
 fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                               const fcm_index *block_ptr,
-                                              const fcm_index *block_dofs, fcm_schwarz **out);
+                                              const fcm_index *block_dofs,
+                                              const unsigned char *row_triple, fcm_schwarz **out);
 
 #endif /* FCM_SOLVE_IMPL_H */
