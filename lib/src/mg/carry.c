@@ -133,6 +133,43 @@ cleanup:
   return st;
 }
 
+/* Are copy k's three rows of level 0's matrix the old copy's rows mapped, column for column
+ * in the same order (the copy graphs' rows: old graph[0], graph[1]; new graph[2], graph[3])? */
+static int same_copy_rows(const mg_carry *c, fcm_index k)
+{
+  const fcm_index *ro = c->row_old[0] + 3 * k, *rn = c->row_new[0];
+  if (ro[0] < 0 || ro[0] % 3 != 0 || ro[1] != ro[0] + 1 || ro[2] != ro[0] + 2) return 0;
+  const fcm_index g = ro[0] / 3, deg = c->graph[0][g + 1] - c->graph[0][g];
+  if (c->graph[2][k + 1] - c->graph[2][k] != deg) return 0;
+  const fcm_index *adj = c->graph[1] + c->graph[0][g], *nadj = c->graph[3] + c->graph[2][k];
+  for (fcm_index q = 0; q < deg; q++)
+    if (rn[3 * adj[q]] != 3 * nadj[q]) return 0; /* the DOFs of a copy map together */
+  return 1;
+}
+
+fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, fcm__schwarz_prior *pr,
+                                      unsigned char **rows_same, int *has)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  *has = 0;
+  *rows_same = NULL;
+  if (!c || c->nlev < 1 || !c->old->lev[0].blk || m->nlev < 2) return FCM_OK;
+  const fcm_index nk = m->lev[0].n / 3;
+  unsigned char *same = NULL;
+  FCM_ALLOC_RAW(ctx, nk + 1, same); /* every entry written below */
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nk > 4096)
+  for (fcm_index k = 0; k < nk; k++)
+    same[k] = (unsigned char)same_copy_rows(c, k);
+  pr->old = c->old->lev[0].blk;
+  pr->row_old = c->row_old[0];
+  pr->same = same;
+  *rows_same = same;
+  *has = 1;
+cleanup:
+  return st;
+}
+
 int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr)
 {
   if (!c || l + 1 >= c->nlev) return 0;

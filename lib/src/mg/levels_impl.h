@@ -293,10 +293,15 @@ fcm_status fcm__mg_level_colors(fcm_mg *m, mg_level *L);
  * blocks, a coarser level's corner blocks. CSR over the blocks, allocated here. */
 fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr, fcm_index **dofs);
 
+struct mg_carry;
+
 /* The block smoothers of every level but the coarsest, from the current level matrices;
  * with `old` (NULL: none), a level l with same[l] (its pattern is old's) takes old's block
- * smoother where its blocks are old's (fcm__mg_keep_blocks()). */
-fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same);
+ * smoother where its blocks are old's (fcm__mg_keep_blocks()); with `carry` (NULL: none; its
+ * maps made), level 0's blocks that are the old hierarchy's mapped copy their positions
+ * (fcm__mg_carry_blocks_prior()). */
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same,
+                                          const struct mg_carry *carry);
 
 /* ---- sweeps.c */
 
@@ -360,6 +365,13 @@ const fcm_space *fcm__mg_pattern_of(const fcm_space *space, const fcm_csr *A);
  * made on old_space's pattern, m not on its space's, the spaces not a full cut pair.
  * @return FCM_OK, FCM_ERR_ALLOC, FCM_ERR_INTERNAL. */
 fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c);
+
+/* What level 0's block smoother may copy positions from (1: *pr set, *rows_same allocated:
+ * per copy of m, its three rows of level 0's matrix are the old copy's rows mapped, in the
+ * same order; the two spaces' copy graphs compared), or 0 where c (NULL: none) has nothing:
+ * no maps or no old block smoother with positions. @return FCM_OK or FCM_ERR_ALLOC. */
+fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, fcm__schwarz_prior *pr,
+                                      unsigned char **rows_same, int *has);
 
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
 int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr);

@@ -306,7 +306,7 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   FCM_TRY(ctx, create_patterns(m, old, carry, same));
   if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));
   if (o.block_smoothing) /* set up as created, or by the fcm_mg_setup() to come */
-    FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same));
+    FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same, carry));
   *mg = m;
   m = NULL;
 cleanup:

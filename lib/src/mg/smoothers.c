@@ -656,11 +656,17 @@ fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr
   return blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
 }
 
-fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same)
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same,
+                                          const struct mg_carry *carry)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
+  unsigned char *rows_same = NULL;
+  fcm__schwarz_prior prior;
+  int has_prior = 0;
+  if (m->values_pending)
+    FCM_TRY(ctx, fcm__mg_carry_blocks_prior(m, carry, &prior, &rows_same, &has_prior));
   for (int l = 0; l + 1 < m->nlev; l++) {
     mg_level *L = &m->lev[l];
     FCM_TRY(ctx, fcm__mg_level_blocks(m, l, &nb, &ptr, &dofs));
@@ -670,12 +676,15 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
     if (nb > 0 && old && same[l])
       FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
     if (nb > 0 && !kept) {
-      if (m->values_pending) /* the row order's flags spare the scans' comparisons */
-        FCM_TRY(ctx, fcm__schwarz_create_blocks_pattern(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs,
-                                                        L->rows.triple, &L->blk));
-      else
+      if (m->values_pending) { /* the row order's flags spare the scans' comparisons */
+        FCM_TRY(ctx, fcm__schwarz_create_blocks_pattern(
+                         ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, L->rows.triple,
+                         l == 0 && has_prior ? &prior : NULL, &L->blk));
+        if (l == 0) m->kept.carried_blocks = fcm__schwarz_carried(L->blk);
+      } else {
         FCM_TRY(ctx,
                 fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
+      }
       FCM_TRY(ctx, block_slabs(m, L));
     }
     FCM_FREE(ctx, ptr);
@@ -686,6 +695,7 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
 cleanup:
   fcm__free(ctx, ptr);
   fcm__free(ctx, dofs);
+  fcm__free(ctx, rows_same);
   return st;
 }
 

@@ -60,6 +60,7 @@ struct fcm_schwarz {
   double *dinv;          /* n: 1/|c_ii| outside the blocks, 0 inside */
   fcm_index *diag;       /* n: position of c_ii in C at creation outside the blocks (-1: none) */
   int blocks_only;       /* the block smoother's: the S_K only (no dinv, no apply) */
+  fcm_index carried;     /* blocks whose positions were copied from a prior's */
   fcm_schwarz_info info;
   int ready;
   /* Setup scratch, allocated at creation so a setup allocates nothing: per thread (nt of
@@ -747,12 +748,96 @@ static void scan_positions(fcm_schwarz *P, const fcm_csr *C, const unsigned char
   }
 }
 
+/* The old blocks by their first DOF (CSR over old's rows), for positions_from(). */
+static fcm_status old_by_first(fcm_ctx *ctx, const fcm_schwarz *old, fcm_index **ptr_out,
+                               fcm_index **blk_out)
+{
+  fcm_status st = FCM_OK;
+  fcm_index *ptr = NULL, *blk = NULL;
+  const fcm_index nb = old->num_blocks;
+  FCM_ALLOC(ctx, old->n + 2, ptr);
+  FCM_ALLOC_RAW(ctx, nb + 1, blk); /* every entry written below */
+  for (fcm_index b = 0; b < nb; b++)
+    ptr[old->dofs[old->block_ptr[b]] + 2]++;
+  for (fcm_index i = 0; i < old->n; i++)
+    ptr[i + 2] += ptr[i + 1];
+  for (fcm_index b = 0; b < nb; b++)
+    blk[ptr[old->dofs[old->block_ptr[b]] + 1]++] = b;
+  *ptr_out = ptr, *blk_out = blk;
+  ptr = blk = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, blk);
+  return st;
+}
+
+/* The old block whose positions are block b's (-1: none): its DOFs block b's mapped
+ * (row_old) one by one, and every row of block b the old one's mapped, column for column in
+ * the same order (same, per node: 3 rows; the positions, counted from a row's start, are then
+ * the same). */
+static fcm_index old_block(const fcm_schwarz *P, const fcm__schwarz_prior *pr,
+                           const fcm_index *optr, const fcm_index *oblk, fcm_index b)
+{
+  const fcm_schwarz *old = pr->old;
+  const fcm_index *d = P->dofs + P->block_ptr[b], m = P->block_ptr[b + 1] - P->block_ptr[b];
+  const fcm_index f = pr->row_old[d[0]];
+  if (f < 0) return -1;
+  for (fcm_index j = 0; j < m; j++)
+    if (!pr->same[d[j] / 3]) return -1;
+  for (fcm_index q = optr[f]; q < optr[f + 1]; q++) {
+    const fcm_index ob = oblk[q], *od = old->dofs + old->block_ptr[ob];
+    if (old->block_ptr[ob + 1] - old->block_ptr[ob] != m) continue;
+    fcm_index j = 1;
+    while (j < m && pr->row_old[d[j]] == od[j])
+      j++;
+    if (j == m) return ob;
+  }
+  return -1;
+}
+
+/* scan_positions(), the positions of the blocks that are old blocks mapped (old_block())
+ * copied from them. */
+static fcm_status positions_from(fcm_schwarz *P, const fcm_csr *C, const unsigned char *tri,
+                                 const fcm__schwarz_prior *pr)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = P->ctx;
+  fcm_index *optr = NULL, *oblk = NULL, carried = 0;
+  const fcm_index nb = P->num_blocks;
+  FCM_TRY(ctx, old_by_first(ctx, pr->old, &optr, &oblk));
+#pragma omp parallel num_threads(P->nt) if (P->nt > 1 && nb > SCAN_PARALLEL_BLOCKS) \
+    reduction(+ : carried)
+  {
+    int *loc = P->loc + (size_t)P->n * (size_t)omp_get_thread_num();
+#pragma omp for schedule(dynamic, 64)
+    for (fcm_index b = 0; b < nb; b++) {
+      const fcm_index ob = old_block(P, pr, optr, oblk, b);
+      const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
+      if (ob >= 0) {
+        memcpy(P->pos + P->pos_off[b], pr->old->pos + pr->old->pos_off[ob],
+               sizeof *P->pos * FCM__SCHWARZ_PACKED(m, 0));
+        P->full[b] = pr->old->full[ob];
+        carried++;
+      } else {
+        scan_pattern(C, tri, m, P->dofs + P->block_ptr[b], loc, P->pos + P->pos_off[b],
+                     &P->full[b]);
+      }
+    }
+  }
+  P->carried = carried;
+cleanup:
+  fcm__free(ctx, optr);
+  fcm__free(ctx, oblk);
+  return st;
+}
+
 /* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()),
  * set up now unless values_later (the positions found from the pattern then). */
 static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                          const fcm_index *block_ptr, const fcm_index *block_dofs,
                          const fcm_schwarz_options *opts, int blocks_only, int values_later,
-                         const unsigned char *tri, fcm_schwarz **out)
+                         const unsigned char *tri, const fcm__schwarz_prior *prior,
+                         fcm_schwarz **out)
 {
   fcm_status st = FCM_OK;
   fcm_schwarz *P = NULL;
@@ -861,7 +946,9 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   P->info.num_colors = P->num_colors;
   for (fcm_index i = 0; i < nr; i++)
     P->info.outside_dofs += !P->inside[i];
-  if (values_later)
+  if (values_later && prior && prior->old && prior->old->pos && prior->old->blocks_only)
+    FCM_TRY(ctx, positions_from(P, C, tri, prior));
+  else if (values_later)
     scan_positions(P, C, tri);
   else
     FCM_TRY(ctx, fcm_schwarz_setup(P, C));
@@ -877,22 +964,28 @@ fcm_status fcm_schwarz_create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_bloc
                               const fcm_index *block_ptr, const fcm_index *block_dofs,
                               const fcm_schwarz_options *opts, fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, 0, NULL, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, opts, 0, 0, NULL, NULL, out);
 }
 
 fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                       const fcm_index *block_ptr, const fcm_index *block_dofs,
                                       fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 0, NULL, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 0, NULL, NULL, out);
 }
 
 fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                               const fcm_index *block_ptr,
                                               const fcm_index *block_dofs,
-                                              const unsigned char *row_triple, fcm_schwarz **out)
+                                              const unsigned char *row_triple,
+                                              const fcm__schwarz_prior *prior, fcm_schwarz **out)
 {
-  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 1, row_triple, out);
+  return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 1, row_triple, prior, out);
+}
+
+fcm_index fcm__schwarz_carried(const fcm_schwarz *P)
+{
+  return P ? P->carried : 0;
 }
 
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
