@@ -305,15 +305,21 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
       last[d[i]] = t;
   }
   /* the last block position a row's columns reach, once per row of a block (the blocks
-   * overlap: a cut cell's row lies in up to nine of them) */
+   * overlap: a cut cell's row lies in up to nine of them); the three rows of a node of one
+   * pattern (the row order's flags) read once */
   FCM_ALLOC_RAW(ctx, n + 1, row_reach);
+  const unsigned char *tri = L->rows.triple;
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
   for (fcm_index i = 0; i < n; i++) {
+    const int three = fcm__mg_is_triple(tri, i - i % 3, n);
+    if (three && i % 3 != 0) continue; /* written with row i - i % 3 */
+    const int rows = three ? 3 : 1;
     fcm_index r = -1;
-    if (last[i] >= 0)
+    if (last[i] >= 0 || (three && (last[i + 1] >= 0 || last[i + 2] >= 0)))
       for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
         r = FCM_MAX(r, last[ci[p]]);
-    row_reach[i] = r;
+    for (int c = 0; c < rows; c++)
+      row_reach[i + c] = last[i + c] >= 0 ? r : -1;
   }
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nb > 1024)
   for (fcm_index t = 0; t < nb; t++) {
