@@ -51,6 +51,15 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
   unsigned char *inactive = mgc_eliminated(p->A, p->n);
   TEST_OK(ctx, fcm_space_matrix_create(p->space, pattern));
   TEST_OK(ctx, fcm__mg_create_pattern_cut(ctx, old, prev, p->space, *pattern, inactive, o, &prep));
+  { /* the block smoothers' positions, copied or scanned, those a creation without old finds */
+    fcm_mg *plain = NULL;
+    TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, p->space, *pattern, inactive, o, &plain));
+    TEST_TRUE(plain->nlev == prep->nlev);
+    for (int l = 0; l + 1 < prep->nlev && l + 1 < plain->nlev; l++)
+      TEST_TRUE(fcm__schwarz_same_positions(prep->lev[l].blk, plain->lev[l].blk));
+    TEST_TRUE(!fcm__schwarz_same_positions(prep->lev[0].blk, plain->lev[1].blk)); /* can fail */
+    fcm_mg_destroy(&plain);
+  }
   memcpy(fcm_csr_values(*pattern), fcm_csr_values_read(p->A),
          sizeof(double) * (size_t)fcm_csr_row_ptr(p->A)[p->n]);
   TEST_OK(ctx, fcm_mg_setup(prep));

@@ -988,6 +988,17 @@ fcm_index fcm__schwarz_carried(const fcm_schwarz *P)
   return P ? P->carried : 0;
 }
 
+int fcm__schwarz_same_positions(const fcm_schwarz *a, const fcm_schwarz *b)
+{
+  if (!a || !b || a->num_blocks != b->num_blocks || !a->pos || !b->pos) return 0;
+  const fcm_index nb = a->num_blocks;
+  if (memcmp(a->block_ptr, b->block_ptr, sizeof *a->block_ptr * (size_t)(nb + 1)) != 0 ||
+      memcmp(a->dofs, b->dofs, sizeof *a->dofs * (size_t)a->block_ptr[nb]) != 0 ||
+      memcmp(a->full, b->full, (size_t)nb) != 0)
+    return 0;
+  return memcmp(a->pos, b->pos, sizeof *a->pos * a->pos_off[nb]) == 0;
+}
+
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)
 {
   fcm_status st = FCM_OK;

@@ -68,5 +68,8 @@ fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fc
                                               const fcm__schwarz_prior *prior, fcm_schwarz **out);
 /* The blocks whose positions were copied from the prior's at creation. */
 fcm_index fcm__schwarz_carried(const fcm_schwarz *P);
+/* 1 when a and b hold the same blocks with the same positions and full flags (both found,
+ * no setup since: a setup may scan a block again), else 0. For the tests. */
+int fcm__schwarz_same_positions(const fcm_schwarz *a, const fcm_schwarz *b);
 
 #endif /* FCM_SOLVE_IMPL_H */
