@@ -78,7 +78,7 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
   if (getenv("FCM_TEST_VERBOSE"))
     printf(
         "%s: %d levels, %lld DOFs; plans carried %d, rows of A P taken %lld of %lld, coarse "
-        "rows %lld of %lld, level 0's blocks' positions copied %lld of %lld; %s fcm_mg_create(), "
+        "rows %lld of %lld, blocks' positions copied %lld (level 0 has %lld); %s fcm_mg_create(), "
         "structure %s the references\n",
         what, fcm_mg_num_levels(prep), (long long)p->n, k.carried_plans,
         (long long)k.carried_ap_rows, (long long)(coarse_rows - prep->lev[prep->nlev - 1].n + p->n),

@@ -54,7 +54,9 @@ void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
   for (int l = 0; l < MG_MAX_LEVELS; l++) {
     fcm__free(ctx, c->row_old[l]);
     fcm__free(ctx, c->row_new[l]);
+    fcm__free(ctx, c->crow_same[l]);
   }
+  memset(c->crow_same, 0, sizeof c->crow_same);
   memset(c->row_old, 0, sizeof c->row_old);
   memset(c->row_new, 0, sizeof c->row_new);
   c->nlev = 0;
@@ -147,22 +149,26 @@ static int same_copy_rows(const mg_carry *c, fcm_index k)
   return 1;
 }
 
-fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, fcm__schwarz_prior *pr,
-                                      unsigned char **rows_same, int *has)
+fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
+                                      fcm__schwarz_prior *pr, unsigned char **rows_same, int *has)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   *has = 0;
   *rows_same = NULL;
-  if (!c || c->nlev < 1 || !c->old->lev[0].blk || m->nlev < 2) return FCM_OK;
-  const fcm_index nk = m->lev[0].n / 3;
+  if (!c || c->nlev <= l || l >= c->old->nlev || !c->old->lev[l].blk || l + 1 >= m->nlev ||
+      (l > 0 && !c->crow_same[l]))
+    return FCM_OK;
+  const fcm_index nk = m->lev[l].n / 3;
+  const unsigned char *cs = c->crow_same[l];
   unsigned char *same = NULL;
   FCM_ALLOC_RAW(ctx, nk + 1, same); /* every entry written below */
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nk > 4096)
   for (fcm_index k = 0; k < nk; k++)
-    same[k] = (unsigned char)same_copy_rows(c, k);
-  pr->old = c->old->lev[0].blk;
-  pr->row_old = c->row_old[0];
+    same[k] = (unsigned char)(l == 0 ? same_copy_rows(c, k)
+                                     : cs[3 * k] && cs[3 * k + 1] && cs[3 * k + 2]);
+  pr->old = c->old->lev[l].blk;
+  pr->row_old = c->row_old[l];
   pr->same = same;
   *rows_same = same;
   *has = 1;

@@ -352,7 +352,9 @@ typedef struct mg_carry {
   const fcm_space *old_space;
   int nlev;
   fcm_index *row_old[MG_MAX_LEVELS], *row_new[MG_MAX_LEVELS];
-  const fcm_index *graph[4]; /* fcm__space_cut_copy_map()'s */
+  const fcm_index *graph[4];               /* fcm__space_cut_copy_map()'s */
+  unsigned char *crow_same[MG_MAX_LEVELS]; /* level l >= 1: its rows that are the old ones
+                                              mapped in the same order (the plans' c_same) */
 } mg_carry;
 
 /* The space when A has the space's pattern (row_ptr and col_idx the space's arrays, shared,
@@ -366,12 +368,13 @@ const fcm_space *fcm__mg_pattern_of(const fcm_space *space, const fcm_csr *A);
  * @return FCM_OK, FCM_ERR_ALLOC, FCM_ERR_INTERNAL. */
 fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c);
 
-/* What level 0's block smoother may copy positions from (1: *pr set, *rows_same allocated:
- * per copy of m, its three rows of level 0's matrix are the old copy's rows mapped, in the
- * same order; the two spaces' copy graphs compared), or 0 where c (NULL: none) has nothing:
- * no maps or no old block smoother with positions. @return FCM_OK or FCM_ERR_ALLOC. */
-fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, fcm__schwarz_prior *pr,
-                                      unsigned char **rows_same, int *has);
+/* What level l's block smoother may copy positions from (*has = 1: *pr set, *rows_same
+ * allocated: per copy of m's level l, its three rows of the level matrix are the old copy's
+ * rows mapped, in the same order; on level 0 the two spaces' copy graphs compared, on the
+ * coarser levels the plans' c_same), or *has = 0 where c (NULL: none) has nothing: no maps or
+ * no old block smoother with positions on that level. @return FCM_OK or FCM_ERR_ALLOC. */
+fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
+                                      fcm__schwarz_prior *pr, unsigned char **rows_same, int *has);
 
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
 int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr);

@@ -670,11 +670,12 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
   fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
   unsigned char *rows_same = NULL;
   fcm__schwarz_prior prior;
-  int has_prior = 0;
-  if (m->values_pending)
-    FCM_TRY(ctx, fcm__mg_carry_blocks_prior(m, carry, &prior, &rows_same, &has_prior));
   for (int l = 0; l + 1 < m->nlev; l++) {
     mg_level *L = &m->lev[l];
+    int has_prior = 0;
+    FCM_FREE(ctx, rows_same);
+    if (m->values_pending)
+      FCM_TRY(ctx, fcm__mg_carry_blocks_prior(m, carry, l, &prior, &rows_same, &has_prior));
     FCM_TRY(ctx, fcm__mg_level_blocks(m, l, &nb, &ptr, &dofs));
     for (fcm_index k = 0; k < nb; k++)
       m->blk_max = FCM_MAX(m->blk_max, ptr[k + 1] - ptr[k]);
@@ -683,10 +684,10 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
       FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
     if (nb > 0 && !kept) {
       if (m->values_pending) { /* the row order's flags spare the scans' comparisons */
-        FCM_TRY(ctx, fcm__schwarz_create_blocks_pattern(
-                         ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, L->rows.triple,
-                         l == 0 && has_prior ? &prior : NULL, &L->blk));
-        if (l == 0) m->kept.carried_blocks = fcm__schwarz_carried(L->blk);
+        FCM_TRY(ctx, fcm__schwarz_create_blocks_pattern(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs,
+                                                        L->rows.triple, has_prior ? &prior : NULL,
+                                                        &L->blk));
+        m->kept.carried_blocks += fcm__schwarz_carried(L->blk);
       } else {
         FCM_TRY(ctx,
                 fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
