@@ -49,6 +49,33 @@ static int carry_possible(const fcm_mg *m, const mg_carry *c)
   return pieces > 0 && pieces == fcm_cell_rules_num_pieces(from->rules);
 }
 
+int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple)
+{
+  const fcm_space *sp = m->pattern_of;
+  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
+      m->lev[0].n != 3 * sp->num_local_copies)
+    return 0;
+  const fcm_index nk = sp->num_local_copies;
+  int ok = 1;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
+    if (nk > 4096)
+  for (fcm_index k = 0; k < nk; k++) { /* the row holds its own copy: the diagonal's node */
+    fcm_index lo = sp->node_ptr[k], hi = sp->node_ptr[k + 1];
+    while (lo < hi) {
+      const fcm_index mid = lo + (hi - lo) / 2;
+      if (sp->node_adj[mid] < k)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    const int own = lo < sp->node_ptr[k + 1] && sp->node_adj[lo] == k;
+    ok = ok && own;
+    triple[3 * k] = (unsigned char)(own ? FCM__MG_TRIPLE_NODES : 0);
+    triple[3 * k + 1] = triple[3 * k + 2] = 0;
+  }
+  return ok;
+}
+
 void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
 {
   for (int l = 0; l < MG_MAX_LEVELS; l++) {

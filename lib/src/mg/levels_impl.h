@@ -376,6 +376,13 @@ fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c);
 fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
                                       fcm__schwarz_prior *pr, unsigned char **rows_same, int *has);
 
+/* Level 0's row order flags (triple, n bytes) from the space's copy graph, where level 0's
+ * matrix has the space's pattern (m->pattern_of, a full space): a copy's three rows hold
+ * three columns for each copy of its graph row, itself among them, so each is
+ * FCM__MG_TRIPLE_NODES, as fcm__mg_row_slabs() finds them from the rows. 1 when written, 0
+ * (triple unfinished) where that does not apply. */
+int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple);
+
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
 int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr);
 

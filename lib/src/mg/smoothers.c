@@ -242,18 +242,23 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
   FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
   row_slabs_lead(L->n, reach, work, &L->rows);
   FCM_ALLOC(ctx, L->n + 1, L->rows.triple);
+  /* level 0 on its space's pattern: the space's copy graph says what the rows would */
+  if (!(L == &m->lev[0] && fcm__mg_space_triples(m, L->rows.triple))) {
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
-  for (fcm_index i = 0; i < n - 2; i += 3) {
-    /* the three rows one pattern, the three's own columns one after the other (diag[i]) */
-    const fcm_index len = rp[i + 1] - rp[i], p = L->diag[i] - rp[i];
-    const int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len && p + 2 < len &&
-                     ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2 &&
-                     !memcmp(ci + rp[i], ci + rp[i + 1], sizeof *ci * (size_t)len) &&
-                     !memcmp(ci + rp[i], ci + rp[i + 2], sizeof *ci * (size_t)len);
-    int nodes = same && len % 3 == 0;
-    for (fcm_index q = rp[i]; nodes && q < rp[i + 1]; q += 3)
-      nodes = ci[q] % 3 == 0 && ci[q + 1] == ci[q] + 1 && ci[q + 2] == ci[q] + 2;
-    L->rows.triple[i] = (unsigned char)(!same ? 0 : nodes ? FCM__MG_TRIPLE_NODES : FCM__MG_TRIPLE);
+    for (fcm_index i = 0; i < n - 2; i += 3) {
+      /* the three rows one pattern, the three's own columns one after the other (diag[i]) */
+      const fcm_index len = rp[i + 1] - rp[i], p = L->diag[i] - rp[i];
+      const int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len &&
+                       p + 2 < len && ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2 &&
+                       !memcmp(ci + rp[i], ci + rp[i + 1], sizeof *ci * (size_t)len) &&
+                       !memcmp(ci + rp[i], ci + rp[i + 2], sizeof *ci * (size_t)len);
+      int nodes = same && len % 3 == 0;
+      for (fcm_index q = rp[i]; nodes && q < rp[i + 1]; q += 3)
+        nodes = ci[q] % 3 == 0 && ci[q + 1] == ci[q] + 1 && ci[q + 2] == ci[q] + 2;
+      L->rows.triple[i] = (unsigned char)(!same   ? 0
+                                          : nodes ? FCM__MG_TRIPLE_NODES
+                                                  : FCM__MG_TRIPLE);
+    }
   }
 cleanup:
   fcm__free(ctx, work);
