@@ -51,6 +51,15 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
   unsigned char *inactive = mgc_eliminated(p->A, p->n);
   TEST_OK(ctx, fcm_space_matrix_create(p->space, pattern));
   TEST_OK(ctx, fcm__mg_create_pattern_cut(ctx, old, prev, p->space, *pattern, inactive, o, &prep));
+  { /* the block smoothers' positions, copied or scanned, those a creation without old finds */
+    fcm_mg *plain = NULL;
+    TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, p->space, *pattern, inactive, o, &plain));
+    TEST_TRUE(plain->nlev == prep->nlev);
+    for (int l = 0; l + 1 < prep->nlev && l + 1 < plain->nlev; l++)
+      TEST_TRUE(fcm__schwarz_same_positions(prep->lev[l].blk, plain->lev[l].blk));
+    TEST_TRUE(!fcm__schwarz_same_positions(prep->lev[0].blk, plain->lev[1].blk)); /* can fail */
+    fcm_mg_destroy(&plain);
+  }
   memcpy(fcm_csr_values(*pattern), fcm_csr_values_read(p->A),
          sizeof(double) * (size_t)fcm_csr_row_ptr(p->A)[p->n]);
   TEST_OK(ctx, fcm_mg_setup(prep));
@@ -67,13 +76,15 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
   fcm__mg_kept k;
   fcm__mg_get_kept(prep, &k);
   if (getenv("FCM_TEST_VERBOSE"))
-    printf("%s: %d levels, %lld DOFs; plans carried %d, rows of A P taken %lld of %lld, coarse "
-           "rows %lld of %lld; %s fcm_mg_create(), structure %s the references\n",
-           what, fcm_mg_num_levels(prep), (long long)p->n, k.carried_plans,
-           (long long)k.carried_ap_rows,
-           (long long)(coarse_rows - prep->lev[prep->nlev - 1].n + p->n),
-           (long long)k.carried_coarse_rows, (long long)coarse_rows,
-           same ? "equals" : "DIFFERS from", exact ? "equals" : "DIFFERS from");
+    printf(
+        "%s: %d levels, %lld DOFs; plans carried %d, rows of A P taken %lld of %lld, coarse "
+        "rows %lld of %lld, blocks' positions copied %lld (level 0 has %lld); %s fcm_mg_create(), "
+        "structure %s the references\n",
+        what, fcm_mg_num_levels(prep), (long long)p->n, k.carried_plans,
+        (long long)k.carried_ap_rows, (long long)(coarse_rows - prep->lev[prep->nlev - 1].n + p->n),
+        (long long)k.carried_coarse_rows, (long long)coarse_rows, (long long)k.carried_blocks,
+        (long long)fcm__schwarz_num_blocks(prep->lev[0].blk), same ? "equals" : "DIFFERS from",
+        exact ? "equals" : "DIFFERS from");
   TEST_TRUE(fcm_mg_num_levels(prep) >= 3);
   TEST_TRUE(same);
   TEST_TRUE(exact);
@@ -81,6 +92,9 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
     TEST_TRUE(k.carried_plans == FCM_MIN(old->nlev, prep->nlev) - 1);
     TEST_TRUE(k.carried_ap_rows > p->n / 3);
     TEST_TRUE(k.carried_coarse_rows > coarse_rows / 5);
+    TEST_TRUE(k.carried_blocks > fcm__schwarz_num_blocks(prep->lev[0].blk) / 3);
+  } else {
+    TEST_TRUE(k.carried_blocks == 0);
   }
   fcm_mg_destroy(&fresh);
   free(inactive);
@@ -186,7 +200,8 @@ static void plain_carries(fcm_ctx *ctx, fcm_mg *const olds[2], const fcm_mg *old
     TEST_OK(ctx, fcm_mg_setup(mg));
     fcm__mg_kept k;
     fcm__mg_get_kept(mg, &k);
-    TEST_TRUE(k.carried_plans == 0 && k.carried_ap_rows == 0 && k.carried_coarse_rows == 0);
+    TEST_TRUE(k.carried_plans == 0 && k.carried_ap_rows == 0 && k.carried_coarse_rows == 0 &&
+              k.carried_blocks == 0);
     TEST_TRUE(mgc_same(ctx, mg, fresh[q == 2], next->b, next->n, 2));
     fcm_mg_destroy(&mg);
   }

@@ -202,12 +202,14 @@ typedef struct fcm__ptap_prior {
 
 /* fcm__ptap_create() with the rows of A P and C that `prior` shows unchanged (the inputs
  * compared entry by entry through the maps) taken over mapped instead of computed: the same
- * plan and C bit for bit. taken (may be NULL): the rows of A P and of C taken over.
- * @return as fcm__ptap_create(). */
+ * plan and C bit for bit. taken (may be NULL): the rows of A P and of C taken over. c_same
+ * (NULL: not wanted): per row of C (nc + 1 bytes, allocated here, the caller's), 1 where it is
+ * the old row mapped column for column in the same order (taken, its mapped columns
+ * ascending). @return as fcm__ptap_create(). */
 fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, const fcm_csr *A,
                                  fcm_index nc, const fcm_index *P_ptr, const int *P_col,
                                  const double *P_val, int with_diagonal, int nt, fcm__ptap **plan,
-                                 fcm_csr **C, fcm_index taken[2]);
+                                 fcm_csr **C, fcm_index taken[2], unsigned char **c_same);
 
 /* C's values = P^T A P for A's current values, on `nt` threads (clamped to [1, the plan's]).
  * A has the pattern given to fcm__ptap_create(), C is the matrix it created. Allocates

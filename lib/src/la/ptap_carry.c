@@ -14,6 +14,7 @@ typedef struct carry_work {
   const int *Ac, *Pc, *Rc, *APc;
   int *Cc;
   unsigned char *prow, *keep, *ckeep; /* rows of P, A P and C that are the old ones mapped */
+  unsigned char *csame;               /* rows of C taken in the old order (NULL: not wanted) */
   const unsigned char *same3;         /* the new plan's */
   unsigned char *cdup;                /* per group of C's rows: R's rows shifted (their rows of
                                          A P of one pattern): one pattern before the diagonal */
@@ -98,8 +99,8 @@ static int carry_crow(const carry_work *w, fcm_index I)
   return 1;
 }
 
-/* Row I of C taken over: the old row mapped, sorted. */
-static void carry_c_taken(const carry_work *w, fcm_index I, int *out)
+/* Row I of C taken over: the old row mapped, sorted; 1 when the mapping kept the order. */
+static int carry_c_taken(const carry_work *w, fcm_index I, int *out)
 {
   const fcm_index Io = w->pr->crow_old[I], *op = fcm_csr_row_ptr(w->pr->C);
   const int *oc = fcm_csr_col_idx(w->pr->C) + op[Io];
@@ -110,6 +111,7 @@ static void carry_c_taken(const carry_work *w, fcm_index I, int *out)
     sorted &= q == 0 || out[q] > out[q - 1];
   }
   if (!sorted) fcm__ptap_sort_ints(out, len);
+  return sorted;
 }
 
 /* The rows of A P (stage 0) or of C (stage 1): which are taken over, their counts (pass 0) and
@@ -149,7 +151,10 @@ static void carry_rows(carry_work *w, int stage, int pass, fcm_index *ptr, int *
         if (!pass) ptr[i + 1] = len;
       } else if (keep[i]) {
         const fcm_index *op = fcm_csr_row_ptr(w->pr->C);
-        if (out) carry_c_taken(w, i, out);
+        if (out) {
+          const int sorted = carry_c_taken(w, i, out);
+          if (w->csame) w->csame[i] = (unsigned char)sorted;
+        }
         if (!pass) ptr[i + 1] = op[io + 1] - op[io];
       } else {
         const fcm_index cnt =
@@ -167,7 +172,7 @@ static void carry_rows(carry_work *w, int stage, int pass, fcm_index *ptr, int *
 fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, const fcm_csr *A,
                                  fcm_index nc, const fcm_index *P_ptr, const int *P_col,
                                  const double *P_val, int with_diagonal, int nt, fcm__ptap **plan,
-                                 fcm_csr **C, fcm_index taken[2])
+                                 fcm_csr **C, fcm_index taken[2], unsigned char **c_same)
 {
   fcm_status st = FCM_OK;
   fcm__ptap *t = NULL;
@@ -191,6 +196,10 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
     FCM_CHECK(!missing, ctx, FCM_ERR_ARG, "ptap_create_from: the prior's %s is NULL", missing);
   }
   *plan = NULL, *C = NULL;
+  if (c_same) {
+    *c_same = NULL;
+    FCM_ALLOC(ctx, nc + 1, w.csame);
+  }
   FCM_TRY(ctx, fcm__ptap_begin(ctx, A, nc, P_ptr, P_col, P_val, nt, "ptap_create_from", &t));
   const fcm_index n = t->n;
   w.old = prior->plan, w.n = n;
@@ -243,7 +252,9 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   }
   *plan = t;
   t = NULL;
+  if (c_same) *c_same = w.csame, w.csame = NULL;
 cleanup:
+  fcm__free(ctx, w.csame);
   fcm__free(ctx, cp);
   fcm__free(ctx, cc);
   fcm__free(ctx, mk);

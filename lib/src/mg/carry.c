@@ -49,12 +49,41 @@ static int carry_possible(const fcm_mg *m, const mg_carry *c)
   return pieces > 0 && pieces == fcm_cell_rules_num_pieces(from->rules);
 }
 
+int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple)
+{
+  const fcm_space *sp = m->pattern_of;
+  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
+      m->lev[0].n != 3 * sp->num_local_copies)
+    return 0;
+  const fcm_index nk = sp->num_local_copies;
+  int ok = 1;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
+    if (nk > 4096)
+  for (fcm_index k = 0; k < nk; k++) { /* the row holds its own copy: the diagonal's node */
+    fcm_index lo = sp->node_ptr[k], hi = sp->node_ptr[k + 1];
+    while (lo < hi) {
+      const fcm_index mid = lo + (hi - lo) / 2;
+      if (sp->node_adj[mid] < k)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    const int own = lo < sp->node_ptr[k + 1] && sp->node_adj[lo] == k;
+    ok = ok && own;
+    triple[3 * k] = (unsigned char)(own ? FCM__MG_TRIPLE_NODES : 0);
+    triple[3 * k + 1] = triple[3 * k + 2] = 0;
+  }
+  return ok;
+}
+
 void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
 {
   for (int l = 0; l < MG_MAX_LEVELS; l++) {
     fcm__free(ctx, c->row_old[l]);
     fcm__free(ctx, c->row_new[l]);
+    fcm__free(ctx, c->crow_same[l]);
   }
+  memset(c->crow_same, 0, sizeof c->crow_same);
   memset(c->row_old, 0, sizeof c->row_old);
   memset(c->row_new, 0, sizeof c->row_new);
   c->nlev = 0;
@@ -130,6 +159,47 @@ fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c)
   }
 cleanup:
   fcm__free(ctx, old_copy);
+  return st;
+}
+
+/* Are copy k's three rows of level 0's matrix the old copy's rows mapped, column for column
+ * in the same order (the copy graphs' rows: old graph[0], graph[1]; new graph[2], graph[3])? */
+static int same_copy_rows(const mg_carry *c, fcm_index k)
+{
+  const fcm_index *ro = c->row_old[0] + 3 * k, *rn = c->row_new[0];
+  if (ro[0] < 0 || ro[0] % 3 != 0 || ro[1] != ro[0] + 1 || ro[2] != ro[0] + 2) return 0;
+  const fcm_index g = ro[0] / 3, deg = c->graph[0][g + 1] - c->graph[0][g];
+  if (c->graph[2][k + 1] - c->graph[2][k] != deg) return 0;
+  const fcm_index *adj = c->graph[1] + c->graph[0][g], *nadj = c->graph[3] + c->graph[2][k];
+  for (fcm_index q = 0; q < deg; q++)
+    if (rn[3 * adj[q]] != 3 * nadj[q]) return 0; /* the DOFs of a copy map together */
+  return 1;
+}
+
+fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
+                                      fcm__schwarz_prior *pr, unsigned char **rows_same, int *has)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  *has = 0;
+  *rows_same = NULL;
+  if (!c || c->nlev <= l || l >= c->old->nlev || !c->old->lev[l].blk || l + 1 >= m->nlev ||
+      (l > 0 && !c->crow_same[l]))
+    return FCM_OK;
+  const fcm_index nk = m->lev[l].n / 3;
+  const unsigned char *cs = c->crow_same[l];
+  unsigned char *same = NULL;
+  FCM_ALLOC_RAW(ctx, nk + 1, same); /* every entry written below */
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nk > 4096)
+  for (fcm_index k = 0; k < nk; k++)
+    same[k] = (unsigned char)(l == 0 ? same_copy_rows(c, k)
+                                     : cs[3 * k] && cs[3 * k + 1] && cs[3 * k + 2]);
+  pr->old = c->old->lev[l].blk;
+  pr->row_old = c->row_old[l];
+  pr->same = same;
+  *rows_same = same;
+  *has = 1;
+cleanup:
   return st;
 }
 

@@ -226,6 +226,10 @@ static inline __attribute__((always_inline)) void fcm__mg_row_dot3(const double 
  * whole nodes too (FCM__MG_TRIPLE_NODES, fcm__mg_row_dot3()'s nodes). */
 #define FCM__MG_TRIPLE       1
 #define FCM__MG_TRIPLE_NODES 2
+/* the flags are the block smoothers' hints to fcm__schwarz_create_blocks_pattern() */
+_Static_assert(FCM__MG_TRIPLE == FCM__SCHWARZ_ROWS_SAME &&
+                   FCM__MG_TRIPLE_NODES == FCM__SCHWARZ_ROWS_NODES,
+               "row flags");
 
 /* Whether rows i, i + 1, i + 2 may be summed by fcm__mg_row_dot3() (triple: the level's row
  * order's flags, NULL: none may). */
@@ -289,10 +293,15 @@ fcm_status fcm__mg_level_colors(fcm_mg *m, mg_level *L);
  * blocks, a coarser level's corner blocks. CSR over the blocks, allocated here. */
 fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr, fcm_index **dofs);
 
+struct mg_carry;
+
 /* The block smoothers of every level but the coarsest, from the current level matrices;
  * with `old` (NULL: none), a level l with same[l] (its pattern is old's) takes old's block
- * smoother where its blocks are old's (fcm__mg_keep_blocks()). */
-fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same);
+ * smoother where its blocks are old's (fcm__mg_keep_blocks()); with `carry` (NULL: none; its
+ * maps made), level 0's blocks that are the old hierarchy's mapped copy their positions
+ * (fcm__mg_carry_blocks_prior()). */
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same,
+                                          const struct mg_carry *carry);
 
 /* ---- sweeps.c */
 
@@ -343,7 +352,9 @@ typedef struct mg_carry {
   const fcm_space *old_space;
   int nlev;
   fcm_index *row_old[MG_MAX_LEVELS], *row_new[MG_MAX_LEVELS];
-  const fcm_index *graph[4]; /* fcm__space_cut_copy_map()'s */
+  const fcm_index *graph[4];               /* fcm__space_cut_copy_map()'s */
+  unsigned char *crow_same[MG_MAX_LEVELS]; /* level l >= 1: its rows that are the old ones
+                                              mapped in the same order (the plans' c_same) */
 } mg_carry;
 
 /* The space when A has the space's pattern (row_ptr and col_idx the space's arrays, shared,
@@ -356,6 +367,21 @@ const fcm_space *fcm__mg_pattern_of(const fcm_space *space, const fcm_csr *A);
  * made on old_space's pattern, m not on its space's, the spaces not a full cut pair.
  * @return FCM_OK, FCM_ERR_ALLOC, FCM_ERR_INTERNAL. */
 fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c);
+
+/* What level l's block smoother may copy positions from (*has = 1: *pr set, *rows_same
+ * allocated: per copy of m's level l, its three rows of the level matrix are the old copy's
+ * rows mapped, in the same order; on level 0 the two spaces' copy graphs compared, on the
+ * coarser levels the plans' c_same), or *has = 0 where c (NULL: none) has nothing: no maps or
+ * no old block smoother with positions on that level. @return FCM_OK or FCM_ERR_ALLOC. */
+fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
+                                      fcm__schwarz_prior *pr, unsigned char **rows_same, int *has);
+
+/* Level 0's row order flags (triple, n bytes) from the space's copy graph, where level 0's
+ * matrix has the space's pattern (m->pattern_of, a full space): a copy's three rows hold
+ * three columns for each copy of its graph row, itself among them, so each is
+ * FCM__MG_TRIPLE_NODES, as fcm__mg_row_slabs() finds them from the rows. 1 when written, 0
+ * (triple unfinished) where that does not apply. */
+int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple);
 
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
 int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr);

@@ -153,7 +153,7 @@ cleanup:
 /* The Galerkin product's plan and pattern of level l + 1 (from level l's matrix pattern and
  * P_l), with every diagonal entry (rows of empty columns); the restriction R_l = P_l^T the
  * plan holds. */
-static fcm_status galerkin_pattern(fcm_mg *m, int l, const mg_carry *carry)
+static fcm_status galerkin_pattern(fcm_mg *m, int l, mg_carry *carry)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
@@ -165,7 +165,7 @@ static fcm_status galerkin_pattern(fcm_mg *m, int l, const mg_carry *carry)
   fcm__ptap_prior prior;
   if (fcm__mg_carry_prior(m, carry, l, &prior)) {
     FCM_TRY(ctx, fcm__ptap_create_from(ctx, &prior, A, C->n, L->P_ptr, L->P_col, L->P_val, 1, nt,
-                                       &L->ptap, &C->Aown, taken));
+                                       &L->ptap, &C->Aown, taken, &carry->crow_same[l + 1]));
     m->kept.carried_plans++;
     m->kept.carried_ap_rows += taken[0];
     m->kept.carried_coarse_rows += taken[1];
@@ -234,8 +234,7 @@ cleanup:
 
 /* The levels' Galerkin plans and patterns, row orders and the coarsest analysis (keeping
  * old's where fcm__mg_create_from() may; same[l]: level l's pattern is old's). */
-static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, const mg_carry *carry,
-                                  unsigned char *same)
+static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, mg_carry *carry, unsigned char *same)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
@@ -306,7 +305,7 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   FCM_TRY(ctx, create_patterns(m, old, carry, same));
   if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));
   if (o.block_smoothing) /* set up as created, or by the fcm_mg_setup() to come */
-    FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same));
+    FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same, carry));
   *mg = m;
   m = NULL;
 cleanup:

@@ -78,6 +78,7 @@ typedef struct fcm__mg_kept {
    * before the cut, and the rows of A P and of the coarse patterns taken, all levels */
   int carried_plans;
   fcm_index carried_ap_rows, carried_coarse_rows;
+  fcm_index carried_blocks; /* blocks whose positions were copied, all levels */
 } fcm__mg_kept;
 
 /* fcm_mg_create(ctx, space, A, opts, mg), taking from *old (NULL or *old == NULL: nothing)

@@ -242,18 +242,23 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
   FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
   row_slabs_lead(L->n, reach, work, &L->rows);
   FCM_ALLOC(ctx, L->n + 1, L->rows.triple);
+  /* level 0 on its space's pattern: the space's copy graph says what the rows would */
+  if (!(L == &m->lev[0] && fcm__mg_space_triples(m, L->rows.triple))) {
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
-  for (fcm_index i = 0; i < n - 2; i += 3) {
-    /* the three rows one pattern, the three's own columns one after the other (diag[i]) */
-    const fcm_index len = rp[i + 1] - rp[i], p = L->diag[i] - rp[i];
-    const int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len && p + 2 < len &&
-                     ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2 &&
-                     !memcmp(ci + rp[i], ci + rp[i + 1], sizeof *ci * (size_t)len) &&
-                     !memcmp(ci + rp[i], ci + rp[i + 2], sizeof *ci * (size_t)len);
-    int nodes = same && len % 3 == 0;
-    for (fcm_index q = rp[i]; nodes && q < rp[i + 1]; q += 3)
-      nodes = ci[q] % 3 == 0 && ci[q + 1] == ci[q] + 1 && ci[q + 2] == ci[q] + 2;
-    L->rows.triple[i] = (unsigned char)(!same ? 0 : nodes ? FCM__MG_TRIPLE_NODES : FCM__MG_TRIPLE);
+    for (fcm_index i = 0; i < n - 2; i += 3) {
+      /* the three rows one pattern, the three's own columns one after the other (diag[i]) */
+      const fcm_index len = rp[i + 1] - rp[i], p = L->diag[i] - rp[i];
+      const int same = rp[i + 2] - rp[i + 1] == len && rp[i + 3] - rp[i + 2] == len &&
+                       p + 2 < len && ci[rp[i] + p + 1] == i + 1 && ci[rp[i] + p + 2] == i + 2 &&
+                       !memcmp(ci + rp[i], ci + rp[i + 1], sizeof *ci * (size_t)len) &&
+                       !memcmp(ci + rp[i], ci + rp[i + 2], sizeof *ci * (size_t)len);
+      int nodes = same && len % 3 == 0;
+      for (fcm_index q = rp[i]; nodes && q < rp[i + 1]; q += 3)
+        nodes = ci[q] % 3 == 0 && ci[q + 1] == ci[q] + 1 && ci[q + 2] == ci[q] + 2;
+      L->rows.triple[i] = (unsigned char)(!same   ? 0
+                                          : nodes ? FCM__MG_TRIPLE_NODES
+                                                  : FCM__MG_TRIPLE);
+    }
   }
 cleanup:
   fcm__free(ctx, work);
@@ -305,15 +310,21 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
       last[d[i]] = t;
   }
   /* the last block position a row's columns reach, once per row of a block (the blocks
-   * overlap: a cut cell's row lies in up to nine of them) */
+   * overlap: a cut cell's row lies in up to nine of them); the three rows of a node of one
+   * pattern (the row order's flags) read once */
   FCM_ALLOC_RAW(ctx, n + 1, row_reach);
+  const unsigned char *tri = L->rows.triple;
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
   for (fcm_index i = 0; i < n; i++) {
+    const int three = fcm__mg_is_triple(tri, i - i % 3, n);
+    if (three && i % 3 != 0) continue; /* written with row i - i % 3 */
+    const int rows = three ? 3 : 1;
     fcm_index r = -1;
-    if (last[i] >= 0)
+    if (last[i] >= 0 || (three && (last[i + 1] >= 0 || last[i + 2] >= 0)))
       for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
         r = FCM_MAX(r, last[ci[p]]);
-    row_reach[i] = r;
+    for (int c = 0; c < rows; c++)
+      row_reach[i + c] = last[i + c] >= 0 ? r : -1;
   }
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nb > 1024)
   for (fcm_index t = 0; t < nb; t++) {
@@ -656,13 +667,20 @@ fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr
   return blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
 }
 
-fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same)
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same,
+                                          const struct mg_carry *carry)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
+  unsigned char *rows_same = NULL;
+  fcm__schwarz_prior prior;
   for (int l = 0; l + 1 < m->nlev; l++) {
     mg_level *L = &m->lev[l];
+    int has_prior = 0;
+    FCM_FREE(ctx, rows_same);
+    if (m->values_pending)
+      FCM_TRY(ctx, fcm__mg_carry_blocks_prior(m, carry, l, &prior, &rows_same, &has_prior));
     FCM_TRY(ctx, fcm__mg_level_blocks(m, l, &nb, &ptr, &dofs));
     for (fcm_index k = 0; k < nb; k++)
       m->blk_max = FCM_MAX(m->blk_max, ptr[k + 1] - ptr[k]);
@@ -670,9 +688,15 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
     if (nb > 0 && old && same[l])
       FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
     if (nb > 0 && !kept) {
-      FCM_TRY(ctx,
-              (m->values_pending ? fcm__schwarz_create_blocks_pattern : fcm__schwarz_create_blocks)(
-                  ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
+      if (m->values_pending) { /* the row order's flags spare the scans' comparisons */
+        FCM_TRY(ctx, fcm__schwarz_create_blocks_pattern(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs,
+                                                        L->rows.triple, has_prior ? &prior : NULL,
+                                                        &L->blk));
+        m->kept.carried_blocks += fcm__schwarz_carried(L->blk);
+      } else {
+        FCM_TRY(ctx,
+                fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
+      }
       FCM_TRY(ctx, block_slabs(m, L));
     }
     FCM_FREE(ctx, ptr);
@@ -683,6 +707,7 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
 cleanup:
   fcm__free(ctx, ptr);
   fcm__free(ctx, dofs);
+  fcm__free(ctx, rows_same);
   return st;
 }
 

@@ -40,11 +40,36 @@ void fcm__schwarz_get_view(const fcm_schwarz *P, fcm__schwarz_view *v);
 fcm_status fcm__schwarz_create_blocks(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                       const fcm_index *block_ptr, const fcm_index *block_dofs,
                                       fcm_schwarz **out);
+/* What fcm__schwarz_create_blocks_pattern() may copy positions from: an earlier block
+ * smoother `old` (of fcm__schwarz_create_blocks*(), its positions found) on a matrix before a
+ * renumbering; row_old: per row of the new matrix its row in old's (-1: none); same: per node
+ * k of the new matrix, 1 when its rows 3 k, 3 k + 1, 3 k + 2 are their old rows mapped, column
+ * for column in the same order. A block whose DOFs are an old block's mapped one by one, and
+ * whose rows are all such, takes that block's positions (the ones a scan finds). */
+typedef struct fcm__schwarz_prior {
+  const fcm_schwarz *old;
+  const fcm_index *row_old;
+  const unsigned char *same;
+} fcm__schwarz_prior;
+
 /* fcm__schwarz_create_blocks() without its set-up: C's pattern alone is read (the blocks'
- * positions in C's rows are found from it); the first fcm_schwarz_setup() sets up the values,
- * with the bits the creation's set-up gives. */
+ * positions in C's rows are found from it, or copied from prior's: NULL for none); the first
+ * fcm_schwarz_setup() sets up the values, with the bits the creation's set-up gives.
+ * row_triple (NULL: found from C): per row 3 k, FCM__SCHWARZ_ROWS_SAME when rows 3 k,
+ * 3 k + 1, 3 k + 2 hold one pattern, FCM__SCHWARZ_ROWS_NODES when its columns come in whole
+ * nodes too (3 G, 3 G + 1, 3 G + 2 one after the other), 0 otherwise (a shortcut not taken:
+ * the positions are the same). */
+#define FCM__SCHWARZ_ROWS_SAME  1
+#define FCM__SCHWARZ_ROWS_NODES 2
 fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
                                               const fcm_index *block_ptr,
-                                              const fcm_index *block_dofs, fcm_schwarz **out);
+                                              const fcm_index *block_dofs,
+                                              const unsigned char *row_triple,
+                                              const fcm__schwarz_prior *prior, fcm_schwarz **out);
+/* The blocks whose positions were copied from the prior's at creation. */
+fcm_index fcm__schwarz_carried(const fcm_schwarz *P);
+/* 1 when a and b hold the same blocks with the same positions and full flags (both found,
+ * no setup since: a setup may scan a block again), else 0. For the tests. */
+int fcm__schwarz_same_positions(const fcm_schwarz *a, const fcm_schwarz *b);
 
 #endif /* FCM_SOLVE_IMPL_H */
