@@ -37,6 +37,10 @@ set_tests_properties(mg_octree_cut_hex20_deep PROPERTIES ENVIRONMENT FCM_TEST_MG
 # the one-way block sweeps, and with the vertex blocks alone (the cheapest block set)
 fcm_add_test(mg_convergence_cut_oneway tests/mg/convergence.c ARGS cut 8 16)
 set_tests_properties(mg_convergence_cut_oneway PROPERTIES ENVIRONMENT FCM_TEST_MG_BLOCK_SWEEP=1)
+# the one-way block and pointwise sweeps (Dick's interactive set)
+fcm_add_test(mg_convergence_cut_pointway tests/mg/convergence.c ARGS cut 8 16)
+set_tests_properties(mg_convergence_cut_pointway PROPERTIES
+                     ENVIRONMENT "FCM_TEST_MG_BLOCK_SWEEP=1;FCM_TEST_MG_POINT_SWEEP=1")
 fcm_add_test(mg_convergence_cut_vertex_oneway tests/mg/convergence.c ARGS cut 8 16)
 set_tests_properties(mg_convergence_cut_vertex_oneway PROPERTIES
                      ENVIRONMENT "FCM_TEST_MG_BLOCKS=1;FCM_TEST_MG_BLOCK_SWEEP=1")

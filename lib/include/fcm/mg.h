@@ -101,6 +101,11 @@ typedef struct fcm_mg_options {
                                  forward before the coarse correction and backward after it
                                  (the cycle stays symmetric, half the block work, a weaker
                                  smoothing) */
+  int point_sweep;          /**< 0 (default): each pointwise smoothing step of the "sgs"
+                                 smoother is a forward and a backward sweep; 1: one way, a
+                                 forward sweep before the coarse correction and a backward
+                                 one after it (the cycle stays symmetric with equal pre- and
+                                 post-smoothing steps; half the pointwise work) */
 } fcm_mg_options;
 
 /** Defaults as documented on each member. */

@@ -21,8 +21,12 @@ static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *
   const int *ci = fcm_csr_col_idx(A);
   const double *v = fcm_csr_values_read(A);
   const fcm_index n = L->n, nc = C->n;
-  for (int s = 0; s < m->opts.pre_smooth; s++)
-    fcm__mg_smooth(m, L, b, x);
+  for (int s = 0; s < m->opts.pre_smooth; s++) {
+    if (s > 0 && m->opts.point_sweep) {
+#pragma omp barrier
+    }
+    fcm__mg_smooth(m, L, b, x, 0);
+  }
   if (L->blk && m->opts.pre_smooth > 0) {
 #pragma omp barrier
     fcm__mg_block_smooth(m, L, b, x, 0);
@@ -68,8 +72,12 @@ static void post_smooth(const fcm_mg *m, mg_level *L, const mg_level *C, const d
     fcm__mg_block_smooth(m, L, b, x, 1);
 #pragma omp barrier
   }
-  for (int s = 0; s < m->opts.post_smooth; s++)
-    fcm__mg_smooth(m, L, b, x);
+  for (int s = 0; s < m->opts.post_smooth; s++) {
+    if (s > 0 && m->opts.point_sweep) {
+#pragma omp barrier
+    }
+    fcm__mg_smooth(m, L, b, x, 1);
+  }
 }
 
 static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)

@@ -297,8 +297,10 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
 /* ---- sweeps.c */
 
 /* One smoothing step with the pointwise smoother of m's options, by the team of the enclosing
- * parallel region (no barrier at the end). */
-void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x);
+ * parallel region (no barrier at the end); post: 0 before the coarse correction, 1 after it
+ * (the direction of a one-way step, point_sweep; consecutive one-way steps need a barrier
+ * between them). */
+void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x, int post);
 
 /* A symmetric block Gauss-Seidel sweep over the level's blocks, by the team of the enclosing
  * parallel region (no barrier at the end). */

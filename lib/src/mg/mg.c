@@ -37,6 +37,7 @@ fcm_mg_options fcm_mg_options_default(void)
   o.block_smoothing = 1;
   o.blocks = FCM_MG_BLOCKS_ALL;
   o.block_sweep = 0;
+  o.point_sweep = 0;
   return o;
 }
 
@@ -248,6 +249,11 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_mg_options *opts, fcm_mg
             "mg_create: blocks = %d is not a fcm_mg_blocks", (int)o.blocks);
   FCM_CHECK(o.block_sweep == 0 || o.block_sweep == 1, ctx, FCM_ERR_ARG,
             "mg_create: block_sweep = %d is neither 0 (symmetric) nor 1 (one way)", o.block_sweep);
+  FCM_CHECK(o.point_sweep == 0 || o.point_sweep == 1, ctx, FCM_ERR_ARG,
+            "mg_create: point_sweep = %d is neither 0 (symmetric) nor 1 (one way)", o.point_sweep);
+  FCM_CHECK(o.point_sweep == 0 || o.smoother == FCM_MG_SMOOTHER_SGS, ctx, FCM_ERR_ARG,
+            "mg_create: point_sweep = 1 (one way) needs the SGS smoother (smoother = %d)",
+            (int)o.smoother);
   *out = o;
 cleanup:
   return st;
