@@ -46,7 +46,7 @@ set_tests_properties(mg_convergence_cut_vertex_oneway PROPERTIES
                      ENVIRONMENT "FCM_TEST_MG_BLOCKS=1;FCM_TEST_MG_BLOCK_SWEEP=1")
 fcm_add_test(mg_smooth_paths tests/mg/smooth_paths.c)
 fcm_add_test(mg_block_apply tests/mg/block_apply.c)
-# the Galerkin values by node blocks and level 0's residual against references, bit for bit
-fcm_add_test(mg_values_paths tests/mg/values_paths.c)
+# level 0's residual three rows at a time against fcm_csr_apply(), bit for bit
+fcm_add_test(mg_residual_paths tests/mg/residual_paths.c)
 # two threads' pointwise sweeps with slab 0's lead beside the thin slab, against one thread
 fcm_add_test(mg_row_split tests/mg/row_split.c)

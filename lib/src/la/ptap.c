@@ -1,6 +1,5 @@
 /* The sparse triple product C = P^T A P (PETSc's MatPtAP): patterns once, values as often as A
  * changes, rows shared by the threads with results that do not depend on their number. */
-#include "core/multiversion.h"
 #include "la/ptap_impl.h"
 
 #include <omp.h>
@@ -376,10 +375,9 @@ cleanup:
 }
 
 /* Row i of C = A B on C's pattern into Cv, through spa (zero on entry and exit). */
-static inline __attribute__((always_inline)) void
-product_row(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av, const fcm_index *Bp,
-            const int *Bc, const double *Bv, const fcm_index *Cp, const int *Cc, double *Cv,
-            double *spa)
+static void product_row(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                        const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
+                        const int *Cc, double *Cv, double *spa)
 {
   for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
     const fcm_index k = Ac[p];
@@ -402,27 +400,13 @@ int fcm__ptap_same_pattern3(fcm_index i, const fcm_index *Ap, const int *Ac)
          memcmp(Ac + Ap[i], Ac + Ap[i + 2], sizeof *Ac * (size_t)len) == 0;
 }
 
-/* Rows i, i + 1, i + 2 of C's values from spa3's interleaved slots (3 j + r: row i + r,
- * column j), which are left zero. */
-static inline __attribute__((always_inline)) void gather3(fcm_index i, const fcm_index *Cp,
-                                                          const int *Cc, double *Cv, double *spa3)
-{
-  for (int r = 0; r < 3; r++)
-    for (fcm_index p = Cp[i + r]; p < Cp[i + r + 1]; p++) {
-      double *t = spa3 + 3 * (size_t)Cc[p] + r;
-      Cv[p] = *t;
-      *t = 0.0;
-    }
-}
-
 /* Rows i, i + 1, i + 2 of C = A B when the three rows of A have one pattern (a node's three
  * DOFs): each row of B read once for the three, whose sums go to spa3's interleaved slots
  * (3 j + r: row i + r, column j; zero on entry and exit), each in product_row()'s order.
  * The three rows must hold one pattern (fcm__ptap_same_pattern3()). */
-static inline __attribute__((always_inline)) void
-product_triple(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
-               const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
-               const int *Cc, double *Cv, double *spa3)
+static void product_triple(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                           const fcm_index *Bp, const int *Bc, const double *Bv,
+                           const fcm_index *Cp, const int *Cc, double *Cv, double *spa3)
 {
   const fcm_index len = Ap[i + 1] - Ap[i];
   for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
@@ -436,17 +420,21 @@ product_triple(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av
       t[2] += a2 * b;
     }
   }
-  gather3(i, Cp, Cc, Cv, spa3);
+  for (int r = 0; r < 3; r++)
+    for (fcm_index p = Cp[i + r]; p < Cp[i + r + 1]; p++) {
+      double *t = spa3 + 3 * (size_t)Cc[p] + r;
+      Cv[p] = *t;
+      *t = 0.0;
+    }
 }
 
 /* Rows i, i + 1, i + 2 of C = A B when row i + r of A is row i's with each column j + r and
  * the same values, and rows j, j + 1, j + 2 of B (j a column of row i) hold one pattern (R's
  * rows of a coarse node, the rows of A P of a fine node): each column index of B read once for
  * the three, into spa3 as product_triple(), each entry in product_row()'s order. */
-static inline __attribute__((always_inline)) void
-product_shifted(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
-                const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
-                const int *Cc, double *Cv, double *spa3)
+static void product_shifted(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
+                            const fcm_index *Bp, const int *Bc, const double *Bv,
+                            const fcm_index *Cp, const int *Cc, double *Cv, double *spa3)
 {
   for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
     const fcm_index k = Ac[p], len = Bp[k + 1] - Bp[k];
@@ -458,7 +446,12 @@ product_shifted(fcm_index i, const fcm_index *Ap, const int *Ac, const double *A
       t[2] += a * Bv[q + 2 * len];
     }
   }
-  gather3(i, Cp, Cc, Cv, spa3);
+  for (int r = 0; r < 3; r++)
+    for (fcm_index p = Cp[i + r]; p < Cp[i + r + 1]; p++) {
+      double *t = spa3 + 3 * (size_t)Cc[p] + r;
+      Cv[p] = *t;
+      *t = 0.0;
+    }
 }
 
 /* Whether rows i, i + 1, i + 2 (< A's row count) of A = R may go by product_shifted() with
@@ -479,75 +472,12 @@ int fcm__ptap_shifted3(fcm_index i, const fcm_index *Ap, const int *Ac, const do
   return 1;
 }
 
-/* Whether row i's columns come in whole nodes: 3 K, 3 K + 1, 3 K + 2 one after the other. */
-static int row_in_nodes(fcm_index i, const fcm_index *Ap, const int *Ac)
-{
-  if ((Ap[i + 1] - Ap[i]) % 3 != 0) return 0;
-  for (fcm_index p = Ap[i]; p < Ap[i + 1]; p += 3)
-    if (Ac[p] % 3 != 0 || Ac[p + 1] != Ac[p] + 1 || Ac[p + 2] != Ac[p] + 2) return 0;
-  return 1;
-}
-
-/* Rows i, i + 1, i + 2 of C = A B as product_triple() when, besides, the three rows' columns
- * come in whole nodes and each node K's rows of B are row 3 K's shifted per component with
- * the same values (P's rows of a fine node): a node's 3 x 3 block of A times one value of B's
- * row 3 K updates nine neighbouring slots of spa3 (3 (3 J + c) + r), from one column index.
- * Each entry receives the same terms in the same order as in product_triple() (row 3 K + c
- * of B holds the value of row 3 K's column 3 J at column 3 J + c). */
-static inline __attribute__((always_inline)) void
-product_nodes(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
-              const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
-              const int *Cc, double *Cv, double *spa3)
-{
-  const fcm_index len = Ap[i + 1] - Ap[i];
-  for (fcm_index p = Ap[i]; p < Ap[i + 1]; p += 3) {
-    const fcm_index k = Ac[p];
-    double a[9]; /* a[3 c + r]: row i + r, column k + c */
-    for (int c = 0; c < 3; c++)
-      for (int r = 0; r < 3; r++)
-        a[3 * c + r] = Av[p + c + r * len];
-    for (fcm_index q = Bp[k]; q < Bp[k + 1]; q++) {
-      double *t = spa3 + 3 * (size_t)Bc[q];
-      const double b = Bv[q];
-      for (int e = 0; e < 9; e++)
-        t[e] += a[e] * b;
-    }
-  }
-  gather3(i, Cp, Cc, Cv, spa3);
-}
-
-/* Rows i, i + 1, i + 2 of C = A B as product_shifted() when, besides, the rows of B that
- * row i reaches have their columns in whole nodes: a node's three columns of B's three rows
- * update nine neighbouring slots of spa3 from one column index, each entry in the same order
- * as in product_shifted(). */
-static inline __attribute__((always_inline)) void
-product_shifted_nodes(fcm_index i, const fcm_index *Ap, const int *Ac, const double *Av,
-                      const fcm_index *Bp, const int *Bc, const double *Bv, const fcm_index *Cp,
-                      const int *Cc, double *Cv, double *spa3)
-{
-  for (fcm_index p = Ap[i]; p < Ap[i + 1]; p++) {
-    const fcm_index k = Ac[p], len = Bp[k + 1] - Bp[k];
-    const double a = Av[p];
-    for (fcm_index q = Bp[k]; q < Bp[k + 1]; q += 3) {
-      double *t = spa3 + 3 * (size_t)Bc[q];
-      const double *b = Bv + q;
-      for (int c = 0; c < 3; c++)
-        for (int r = 0; r < 3; r++)
-          t[3 * c + r] += a * b[c + r * len];
-    }
-  }
-  gather3(i, Cp, Cc, Cv, spa3);
-}
-
 /* Values of C = A B on C's pattern, rows shared by the threads of the enclosing region (ends
  * with a barrier), three at a time where they are a node's: kind per group of three rows
- * (KIND_TRIPLE: product_triple(), KIND_SHIFTED: product_shifted(), KIND_NODES:
- * product_nodes(), KIND_SHIFTED_NODES: product_shifted_nodes(), KIND_ROWS: one at a time),
- * or NULL: KIND_TRIPLE where the three hold one pattern, checked here; spa: the calling
- * thread's accumulator, 3 (B's columns + 1) doubles (zero on entry and exit). Each entry is
- * summed in A's row order, then B's. Compiled per CPU (core/multiversion.h: the same
- * roundings). */
-FCM_MULTIVERSION_CLONES
+ * (KIND_TRIPLE: product_triple(), KIND_SHIFTED: product_shifted(), KIND_ROWS: one at a
+ * time), or NULL: KIND_TRIPLE where the three hold one pattern, checked here;
+ * spa: the calling thread's accumulator, 3 (B's columns + 1) doubles (zero on entry and exit).
+ * Each entry is summed in A's row order, then B's. */
 static void product_values(fcm_index nrow, const fcm_index *Ap, const int *Ac, const double *Av,
                            const fcm_index *Bp, const int *Bc, const double *Bv,
                            const fcm_index *Cp, const int *Cc, double *Cv, double *spa,
@@ -558,62 +488,17 @@ static void product_values(fcm_index nrow, const fcm_index *Ap, const int *Ac, c
   for (fcm_index g = 0; g < ng; g++) {
     const fcm_index i = 3 * g;
     const int k = i + 2 >= nrow ? KIND_ROWS : kind ? kind[g] : fcm__ptap_same_pattern3(i, Ap, Ac);
-    switch (k) {
-    case KIND_NODES:
-      product_nodes(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
-      continue;
-    case KIND_SHIFTED_NODES:
-      product_shifted_nodes(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
-      continue;
-    case KIND_TRIPLE:
+    if (k == KIND_TRIPLE) {
       product_triple(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
       continue;
-    case KIND_SHIFTED:
+    }
+    if (k == KIND_SHIFTED) {
       product_shifted(i, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
       continue;
-    default:
-      break;
     }
     for (fcm_index r = i; r < i + 3 && r < nrow; r++)
       product_row(r, Ap, Ac, Av, Bp, Bc, Bv, Cp, Cc, Cv, spa);
   }
-}
-
-/* The node kinds of the plan's two products (product_values()): A's groups of one pattern
- * whose columns come in whole nodes, each node's rows of P shifted with the same values,
- * go by product_nodes(); R's shifted groups whose rows of A P all have their columns in
- * whole nodes by product_shifted_nodes(). ap3: A P's groups of one pattern. */
-static fcm_status node_kinds(fcm__ptap *t, const fcm_csr *A, const unsigned char *ap3)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = t->ctx;
-  const fcm_index n = t->n, *Ap = fcm_csr_row_ptr(A);
-  const int *Ac = fcm_csr_col_idx(A);
-  unsigned char *pnode = NULL, *apnode = NULL;
-  FCM_ALLOC(ctx, n / 3 + 1, t->a_kind);
-  FCM_ALLOC(ctx, n / 3 + 1, pnode);
-  FCM_ALLOC(ctx, n / 3 + 1, apnode);
-  for (fcm_index g = 0; 3 * g + 2 < n; g++) {
-    pnode[g] = (unsigned char)fcm__ptap_shifted3(3 * g, t->P_ptr, t->P_col, t->P_val, NULL);
-    apnode[g] = (unsigned char)(ap3[g] && row_in_nodes(3 * g, t->AP_ptr, t->AP_col));
-  }
-  for (fcm_index g = 0; 3 * g + 2 < n; g++) {
-    int nodes = t->same3[g] && row_in_nodes(3 * g, Ap, Ac);
-    for (fcm_index p = Ap[3 * g]; nodes && p < Ap[3 * g + 1]; p += 3)
-      nodes = Ac[p] / 3 < n / 3 && pnode[Ac[p] / 3];
-    t->a_kind[g] = nodes ? KIND_NODES : t->same3[g] ? KIND_TRIPLE : KIND_ROWS;
-  }
-  for (fcm_index g = 0; 3 * g + 2 < t->nc; g++) {
-    if (t->r_kind[g] != KIND_SHIFTED) continue;
-    int nodes = 1;
-    for (fcm_index p = t->R_ptr[3 * g]; nodes && p < t->R_ptr[3 * g + 1]; p++)
-      nodes = t->R_col[p] / 3 < n / 3 && apnode[t->R_col[p] / 3];
-    if (nodes) t->r_kind[g] = KIND_SHIFTED_NODES;
-  }
-cleanup:
-  fcm__free(ctx, pnode);
-  fcm__free(ctx, apnode);
-  return st;
 }
 
 void fcm__ptap_destroy(fcm__ptap **plan)
@@ -630,7 +515,6 @@ void fcm__ptap_destroy(fcm__ptap **plan)
   fcm__free(ctx, t->spa);
   fcm__free(ctx, t->same3);
   fcm__free(ctx, t->r_kind);
-  fcm__free(ctx, t->a_kind);
   fcm__free(ctx, t);
   *plan = NULL;
 }
@@ -675,7 +559,6 @@ fcm_status fcm__ptap_finish(fcm__ptap *t, const fcm_csr *A, const unsigned char 
   for (fcm_index g = 0; 3 * g + 2 < nc; g++)
     t->r_kind[g] =
         fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, t->R_val, ap3) ? KIND_SHIFTED : KIND_ROWS;
-  FCM_TRY(ctx, node_kinds(t, A, ap3));
   /* rows sorted and in range by construction, symmetric with A's pattern */
   FCM_TRY(ctx, fcm__csr_adopt_pattern(ctx, nc, nc, cp, cc, fcm_csr_get_kind(A), C));
 cleanup:
@@ -753,7 +636,7 @@ void fcm__ptap_apply(fcm__ptap *t, const fcm_csr *A, fcm_csr *C, int nt)
   {
     double *spa = t->spa + (size_t)omp_get_thread_num() * 3 * (size_t)(nc + 1);
     product_values(n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), fcm_csr_values_read(A), t->P_ptr,
-                   t->P_col, t->P_val, t->AP_ptr, t->AP_col, t->AP_val, spa, t->a_kind);
+                   t->P_col, t->P_val, t->AP_ptr, t->AP_col, t->AP_val, spa, t->same3);
     product_values(nc, t->R_ptr, t->R_col, t->R_val, t->AP_ptr, t->AP_col, t->AP_val, cp, cc, cv,
                    spa, t->r_kind);
   }

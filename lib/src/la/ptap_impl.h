@@ -20,12 +20,11 @@ struct fcm__ptap {
   double *AP_val;
   double *spa;           /* nt dense accumulators of 3 (nc + 1) doubles, zero between products */
   unsigned char *same3;  /* per group g of A's rows 3 g .. 3 g + 2: one pattern (all three) */
-  unsigned char *r_kind; /* per group of R's rows: KIND_SHIFTED(_NODES) or KIND_ROWS */
-  unsigned char *a_kind; /* per group of A's rows: KIND_NODES, KIND_TRIPLE or KIND_ROWS */
+  unsigned char *r_kind; /* per group of R's rows: KIND_SHIFTED or KIND_ROWS */
 };
 
 /* How a group of three rows of A is multiplied (product_values()). */
-enum { KIND_ROWS = 0, KIND_TRIPLE = 1, KIND_SHIFTED = 2, KIND_NODES = 3, KIND_SHIFTED_NODES = 4 };
+enum { KIND_ROWS = 0, KIND_TRIPLE = 1, KIND_SHIFTED = 2 };
 
 /* Sort a[0 .. n) ascending (distinct values). */
 void fcm__ptap_sort_ints(int *a, fcm_index n);
