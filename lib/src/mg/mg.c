@@ -393,6 +393,16 @@ cleanup:
   return st;
 }
 
+/* Level l's block smoother on its matrix's values: after a set-up of this hierarchy (or its
+ * creation with values) the positions of the blocks' entries were checked against the pattern,
+ * which a set-up keeps (the Galerkin plans rely on it too), so they are not checked again. */
+static fcm_status setup_blocks(fcm_mg *m, int l)
+{
+  const fcm_csr *A = fcm__mg_level_matrix(&m->lev[l]);
+  return m->values_pending ? fcm_schwarz_setup(m->lev[l].blk, A)
+                           : fcm__schwarz_setup_known(m->lev[l].blk, A);
+}
+
 fcm_status fcm_mg_setup(fcm_mg *m)
 {
   fcm_status st = FCM_OK;
@@ -400,8 +410,7 @@ fcm_status fcm_mg_setup(fcm_mg *m)
   FCM_CHECK(m, ctx, FCM_ERR_ARG, "mg_setup: NULL argument");
   FCM_TRY(ctx, level0_values(m));
   for (int l = 0; l + 1 < m->nlev; l++) {
-    if (m->lev[l].blk)
-      FCM_TRY(ctx, fcm_schwarz_setup(m->lev[l].blk, fcm__mg_level_matrix(&m->lev[l])));
+    if (m->lev[l].blk) FCM_TRY(ctx, setup_blocks(m, l));
     FCM_TRY(ctx, galerkin_values(m, l));
   }
   FCM_TRY(ctx, fcm_direct_factor(m->direct,
