@@ -46,6 +46,8 @@ set_tests_properties(mg_convergence_cut_vertex_oneway PROPERTIES
                      ENVIRONMENT "FCM_TEST_MG_BLOCKS=1;FCM_TEST_MG_BLOCK_SWEEP=1")
 fcm_add_test(mg_smooth_paths tests/mg/smooth_paths.c)
 fcm_add_test(mg_block_apply tests/mg/block_apply.c)
+# the coarser levels' values every coarse_interval-th set-up, then those of a fresh hierarchy
+fcm_add_test(mg_coarse_interval tests/mg/coarse_interval.c)
 # level 0's residual three rows at a time against fcm_csr_apply(), bit for bit
 fcm_add_test(mg_residual_paths tests/mg/residual_paths.c)
 # two threads' pointwise sweeps with slab 0's lead beside the thin slab, against one thread

@@ -38,6 +38,7 @@ fcm_mg_options fcm_mg_options_default(void)
   o.blocks = FCM_MG_BLOCKS_ALL;
   o.block_sweep = 0;
   o.point_sweep = 0;
+  o.coarse_interval = 1;
   return o;
 }
 
@@ -251,6 +252,8 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_mg_options *opts, fcm_mg
             "mg_create: block_sweep = %d is neither 0 (symmetric) nor 1 (one way)", o.block_sweep);
   FCM_CHECK(o.point_sweep == 0 || o.point_sweep == 1, ctx, FCM_ERR_ARG,
             "mg_create: point_sweep = %d is neither 0 (symmetric) nor 1 (one way)", o.point_sweep);
+  FCM_CHECK(o.coarse_interval >= 1, ctx, FCM_ERR_ARG,
+            "mg_create: coarse_interval = %d must be >= 1", o.coarse_interval);
   FCM_CHECK(o.point_sweep == 0 || o.smoother == FCM_MG_SMOOTHER_SGS, ctx, FCM_ERR_ARG,
             "mg_create: point_sweep = 1 (one way) needs the SGS smoother (smoother = %d)",
             (int)o.smoother);
@@ -408,14 +411,18 @@ fcm_status fcm_mg_setup(fcm_mg *m)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m ? m->ctx : NULL;
   FCM_CHECK(m, ctx, FCM_ERR_ARG, "mg_setup: NULL argument");
+  /* the coarser levels at the first set-up and every coarse_interval-th after it */
+  const int coarse = m->values_pending || m->setups % m->opts.coarse_interval == 0;
   FCM_TRY(ctx, level0_values(m));
-  for (int l = 0; l + 1 < m->nlev; l++) {
+  for (int l = 0; l + 1 < m->nlev && (l == 0 || coarse); l++) {
     if (m->lev[l].blk) FCM_TRY(ctx, setup_blocks(m, l));
-    FCM_TRY(ctx, galerkin_values(m, l));
+    if (coarse) FCM_TRY(ctx, galerkin_values(m, l));
   }
-  FCM_TRY(ctx, fcm_direct_factor(m->direct,
-                                 fcm_csr_values_read(fcm__mg_level_matrix(&m->lev[m->nlev - 1]))));
+  if (coarse)
+    FCM_TRY(ctx, fcm_direct_factor(
+                     m->direct, fcm_csr_values_read(fcm__mg_level_matrix(&m->lev[m->nlev - 1]))));
   m->values_pending = 0;
+  m->setups++;
 cleanup:
   return st;
 }
