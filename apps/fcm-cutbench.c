@@ -21,13 +21,17 @@
  * none). */
 static const char *const row_interactive[ROW_COUNT] = {
     /* Dick: one Newton iteration of three multigrid V-cycles a step (his 3 V-cycles), the
-     * block smoothing one way (lib/docs/cutting.md, "The interactive step") */
+     * cut cells' blocks and the pointwise smoothing one way, the coarse levels' values every
+     * fourth step (lib/docs/cutting.md, "The interactive step") */
     "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"multigrid\": {\"cycle\": \"v\", "
-    "\"block_sweep\": \"one_way\"}, \"newton\": {\"fixed_iterations\": 1}",
+    "\"blocks\": \"element\", \"block_sweep\": \"one_way\", \"point_sweep\": \"one_way\", "
+    "\"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1}",
     "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"multigrid\": {\"cycle\": \"v\", "
-    "\"block_sweep\": \"one_way\"}, \"newton\": {\"fixed_iterations\": 1}",
+    "\"blocks\": \"element\", \"block_sweep\": \"one_way\", \"point_sweep\": \"one_way\", "
+    "\"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1}",
     "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"multigrid\": {\"cycle\": \"v\", "
-    "\"block_sweep\": \"one_way\"}, \"newton\": {\"fixed_iterations\": 1}",
+    "\"blocks\": \"element\", \"block_sweep\": \"one_way\", \"point_sweep\": \"one_way\", "
+    "\"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1}",
     /* Koschier: one Newton iteration a step, direct solves */
     "\"newton\": {\"fixed_iterations\": 1}", "\"newton\": {\"fixed_iterations\": 1}",
     /* Ton-That: one Newton iteration a step on the PSD-projected tangent (Ton-That's

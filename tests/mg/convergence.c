@@ -68,6 +68,8 @@ int main(int argc, char **argv)
     /* the finest level's block set (fcm_mg_blocks) and the one-way block sweeps */
     if (getenv("FCM_TEST_MG_BLOCKS")) o.blocks = (fcm_mg_blocks)atoi(getenv("FCM_TEST_MG_BLOCKS"));
     if (getenv("FCM_TEST_MG_BLOCK_SWEEP")) o.block_sweep = atoi(getenv("FCM_TEST_MG_BLOCK_SWEEP"));
+    /* the one-way pointwise sweeps */
+    if (getenv("FCM_TEST_MG_POINT_SWEEP")) o.point_sweep = atoi(getenv("FCM_TEST_MG_POINT_SWEEP"));
     fcm_mg *mg = NULL;
     TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg));
     if (!mg) {

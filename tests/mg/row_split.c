@@ -56,7 +56,7 @@ static void smooth(const fcm_mg *mg, int l, int nt, const double *b, const doubl
   {
     TEST_TRUE(omp_get_num_threads() == nt);
     for (int s = 0; s < 3; s++)
-      fcm__mg_smooth(mg, L, b, x);
+      fcm__mg_smooth(mg, L, b, x, 0);
   }
 }
 

@@ -37,10 +37,18 @@ set_tests_properties(mg_octree_cut_hex20_deep PROPERTIES ENVIRONMENT FCM_TEST_MG
 # the one-way block sweeps, and with the vertex blocks alone (the cheapest block set)
 fcm_add_test(mg_convergence_cut_oneway tests/mg/convergence.c ARGS cut 8 16)
 set_tests_properties(mg_convergence_cut_oneway PROPERTIES ENVIRONMENT FCM_TEST_MG_BLOCK_SWEEP=1)
+# the one-way block and pointwise sweeps (Dick's interactive set)
+fcm_add_test(mg_convergence_cut_pointway tests/mg/convergence.c ARGS cut 8 16)
+set_tests_properties(mg_convergence_cut_pointway PROPERTIES
+                     ENVIRONMENT "FCM_TEST_MG_BLOCK_SWEEP=1;FCM_TEST_MG_POINT_SWEEP=1")
 fcm_add_test(mg_convergence_cut_vertex_oneway tests/mg/convergence.c ARGS cut 8 16)
 set_tests_properties(mg_convergence_cut_vertex_oneway PROPERTIES
                      ENVIRONMENT "FCM_TEST_MG_BLOCKS=1;FCM_TEST_MG_BLOCK_SWEEP=1")
 fcm_add_test(mg_smooth_paths tests/mg/smooth_paths.c)
 fcm_add_test(mg_block_apply tests/mg/block_apply.c)
+# the coarser levels' values every coarse_interval-th set-up, then those of a fresh hierarchy
+fcm_add_test(mg_coarse_interval tests/mg/coarse_interval.c)
+# level 0's residual three rows at a time against fcm_csr_apply(), bit for bit
+fcm_add_test(mg_residual_paths tests/mg/residual_paths.c)
 # two threads' pointwise sweeps with slab 0's lead beside the thin slab, against one thread
 fcm_add_test(mg_row_split tests/mg/row_split.c)

@@ -2,7 +2,8 @@
  * with every smoother, on the uncut cube (n = 16: colours of more than 256 rows, smoothed
  * in parallel) and on the cut hemisphere; fcm_mg_setup() with the same values reproduces
  * the same iterates; the preconditioner is symmetric (V- and W-cycle, every smoother:
- * v^T M u = u^T M v to 1e-12 relative; also with the one-way block sweeps); argument errors
+ * v^T M u = u^T M v to 1e-12 relative; also with the one-way block sweeps, and with the
+ * one-way pointwise sweeps beside them, two pre- and post-smoothing steps too); argument errors
  * are reported. */
 #include "mg_util.h"
 
@@ -11,6 +12,7 @@
 /* the block options of solve() and of the symmetry check (fcm_mg_options.blocks, block_sweep) */
 static fcm_mg_blocks blocks = FCM_MG_BLOCKS_ALL;
 static int block_sweep = 0;
+static int point_sweep = 0, smooth_steps = 1; /* fcm_mg_options.point_sweep, pre/post_smooth */
 
 static double *solve(fcm_ctx *ctx, problem *p, fcm_mg_smoother sm, int threads, int resetup)
 {
@@ -19,6 +21,8 @@ static double *solve(fcm_ctx *ctx, problem *p, fcm_mg_smoother sm, int threads, 
   o.smoother = sm;
   o.blocks = blocks;
   o.block_sweep = block_sweep;
+  o.point_sweep = point_sweep;
+  o.pre_smooth = o.post_smooth = smooth_steps;
   o.omega = sm == FCM_MG_SMOOTHER_JACOBI ? fcm_mg_smoother_omega(sm) : 1.2;
   o.coarse_dofs = 100;
   fcm_mg *mg = NULL;
@@ -49,13 +53,16 @@ int main(void)
     else
       problem_hemisphere(ctx, 8, 1, &p);
     /* symmetry of the preconditioner; SGS also with the one-way block sweeps, all blocks and
-     * the vertex blocks alone (sm = FCM_MG_SMOOTHER_COUNT, COUNT + 1) */
-    for (int sm = 0; sm < FCM_MG_SMOOTHER_COUNT + 2; sm++)
+     * the vertex blocks alone (sm = FCM_MG_SMOOTHER_COUNT, COUNT + 1), and with the one-way
+     * pointwise sweeps beside them, one and two smoothing steps (COUNT + 2, COUNT + 3) */
+    for (int sm = 0; sm < FCM_MG_SMOOTHER_COUNT + 4; sm++)
       for (int cyc = 1; cyc <= 2; cyc++) {
         fcm_mg_options o = fcm_mg_options_default();
         o.smoother = sm < FCM_MG_SMOOTHER_COUNT ? (fcm_mg_smoother)sm : FCM_MG_SMOOTHER_SGS;
         o.block_sweep = sm >= FCM_MG_SMOOTHER_COUNT;
         o.blocks = sm == FCM_MG_SMOOTHER_COUNT + 1 ? FCM_MG_BLOCKS_VERTEX : FCM_MG_BLOCKS_ALL;
+        o.point_sweep = sm >= FCM_MG_SMOOTHER_COUNT + 2;
+        o.pre_smooth = o.post_smooth = sm == FCM_MG_SMOOTHER_COUNT + 3 ? 2 : 1;
         o.omega = sm == FCM_MG_SMOOTHER_JACOBI ? fcm_mg_smoother_omega(sm) : 1.3;
         o.cycle_index = cyc;
         o.coarse_dofs = 100;
@@ -101,6 +108,15 @@ int main(void)
       free(x1), free(x2);
       blocks = FCM_MG_BLOCKS_ALL, block_sweep = 0;
     }
+    /* the one-way pointwise sweeps beside the one-way block sweeps, one and two steps */
+    for (int k = 1; k <= 2; k++) {
+      block_sweep = point_sweep = 1, smooth_steps = k;
+      double *x1 = solve(ctx, &p, FCM_MG_SMOOTHER_SGS, 1, 0);
+      double *x2 = solve(ctx, &p, FCM_MG_SMOOTHER_SGS, 2, 0);
+      TEST_TRUE(memcmp(x1, x2, sizeof *x1 * (size_t)p.n) == 0);
+      free(x1), free(x2);
+      block_sweep = point_sweep = 0, smooth_steps = 1;
+    }
     if (kind == 0) {
       /* errors */
       fcm_mg *mg = NULL;
@@ -117,6 +133,13 @@ int main(void)
       o = fcm_mg_options_default();
       o.block_sweep = 2;
       TEST_ERR(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg), FCM_ERR_ARG, "block_sweep");
+      o = fcm_mg_options_default();
+      o.point_sweep = 2;
+      TEST_ERR(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg), FCM_ERR_ARG, "point_sweep");
+      o = fcm_mg_options_default();
+      o.point_sweep = 1;
+      o.smoother = FCM_MG_SMOOTHER_JACOBI;
+      TEST_ERR(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg), FCM_ERR_ARG, "SGS smoother");
       o = fcm_mg_options_default();
       o.max_levels = 0;
       TEST_ERR(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg), FCM_ERR_ARG, "max_levels");

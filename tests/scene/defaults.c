@@ -23,6 +23,8 @@ static void same_mg(const fcm_mg_options *a, const fcm_mg_options *b)
   SAME(a, b, block_smoothing);
   SAME(a, b, blocks);
   SAME(a, b, block_sweep);
+  SAME(a, b, point_sweep);
+  SAME(a, b, coarse_interval);
 }
 
 static void same_integrator(const fcm_integrator_options *a, const fcm_integrator_options *b)

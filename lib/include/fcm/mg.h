@@ -101,6 +101,19 @@ typedef struct fcm_mg_options {
                                  forward before the coarse correction and backward after it
                                  (the cycle stays symmetric, half the block work, a weaker
                                  smoothing) */
+  int point_sweep;          /**< 0 (default): each pointwise smoothing step of the "sgs"
+                                 smoother is a forward and a backward sweep; 1: one way, a
+                                 forward sweep before the coarse correction and a backward
+                                 one after it (the cycle stays symmetric with equal pre- and
+                                 post-smoothing steps; half the pointwise work) */
+  int coarse_interval;      /**< 1 (default): fcm_mg_setup() computes every level's values;
+                                 k > 1: the coarser levels' (Galerkin products, their block
+                                 smoothers, the coarsest factorization) at every k-th set-up
+                                 of a hierarchy only (its first included), the finest level's
+                                 diagonal and block smoother at each: the coarse correction
+                                 then uses operators of up to k - 1 set-ups before (a
+                                 corotated matrix's rotations of a few steps), for the
+                                 products' cost */
 } fcm_mg_options;
 
 /** Defaults as documented on each member. */

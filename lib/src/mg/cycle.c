@@ -21,8 +21,12 @@ static void pre_smooth(const fcm_mg *m, mg_level *L, mg_level *C, const double *
   const int *ci = fcm_csr_col_idx(A);
   const double *v = fcm_csr_values_read(A);
   const fcm_index n = L->n, nc = C->n;
-  for (int s = 0; s < m->opts.pre_smooth; s++)
-    fcm__mg_smooth(m, L, b, x);
+  for (int s = 0; s < m->opts.pre_smooth; s++) {
+    if (s > 0 && m->opts.point_sweep) {
+#pragma omp barrier
+    }
+    fcm__mg_smooth(m, L, b, x, 0);
+  }
   if (L->blk && m->opts.pre_smooth > 0) {
 #pragma omp barrier
     fcm__mg_block_smooth(m, L, b, x, 0);
@@ -68,8 +72,12 @@ static void post_smooth(const fcm_mg *m, mg_level *L, const mg_level *C, const d
     fcm__mg_block_smooth(m, L, b, x, 1);
 #pragma omp barrier
   }
-  for (int s = 0; s < m->opts.post_smooth; s++)
-    fcm__mg_smooth(m, L, b, x);
+  for (int s = 0; s < m->opts.post_smooth; s++) {
+    if (s > 0 && m->opts.point_sweep) {
+#pragma omp barrier
+    }
+    fcm__mg_smooth(m, L, b, x, 1);
+  }
 }
 
 static fcm_status cycle(fcm_mg *m, int l, const double *b, double *x)
@@ -108,6 +116,59 @@ fcm_status fcm_mg_operator(void *user, const double *r, double *z)
   fcm_mg *m = user;
   if (m && z) memset(z, 0, sizeof *z * (size_t)m->lev[0].n);
   return fcm_mg_cycle(m, r, z);
+}
+
+/* r = b - A x on rows [i0, i1) (a copy's three rows of one pattern together: three chains of
+ * additions side by side, each x read once for the three), each row's sum term by term in
+ * its row order as fcm_csr_apply() forms it, so r_i = b_i + (-1 (A x)_i) bit for bit. */
+FCM_MULTIVERSION_CLONES
+static void residual_rows(const fcm_csr *A, const unsigned char *triple, fcm_index i0, fcm_index i1,
+                          const double *b, const double *x, double *r)
+{
+  fcm_index n = 0;
+  fcm_csr_get_size(A, &n, NULL, NULL);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  const double *v = fcm_csr_values_read(A);
+  for (fcm_index i = i0; i < i1;) {
+    if (i % 3 == 0 && i + 2 < i1 && fcm__mg_is_triple(triple, i, n)) {
+      const fcm_index len = rp[i + 1] - rp[i];
+      const double *va = v + rp[i], *vb = va + len, *vc = vb + len;
+      const int *c = ci + rp[i];
+      double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+      for (fcm_index p = 0; p < len; p++) {
+        const double xp = x[c[p]];
+        s0 += va[p] * xp;
+        s1 += vb[p] * xp;
+        s2 += vc[p] * xp;
+      }
+      r[i] = b[i] + -1.0 * s0;
+      r[i + 1] = b[i + 1] + -1.0 * s1;
+      r[i + 2] = b[i + 2] + -1.0 * s2;
+      i += 3;
+      continue;
+    }
+    double s = 0.0;
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      s += v[p] * x[ci[p]];
+    r[i] = b[i] + -1.0 * s;
+    i++;
+  }
+}
+
+void fcm__mg_residual(const fcm_mg *m, const double *b, const double *x, double *r)
+{
+  const mg_level *L = &m->lev[0];
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  fcm_index nnz = 0;
+  fcm_csr_get_size(A, NULL, NULL, &nnz);
+  const fcm_index ng = (L->n + 2) / 3;
+#pragma omp parallel num_threads(fcm__mg_team(m)) if (nnz >= MG_PARALLEL_NNZ)
+  {
+    const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    const fcm_index g0 = ng * t / nt, g1 = ng * (t + 1) / nt;
+    residual_rows(A, L->rows.triple, 3 * g0, FCM_MIN(3 * g1, L->n), b, x, r);
+  }
 }
 
 static double norm2(fcm_index n, const double *v)

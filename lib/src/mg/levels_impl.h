@@ -118,6 +118,7 @@ struct fcm_mg {
   fcm_space *oct_space[MG_MAX_LEVELS]; /* and their spaces */
   fcm__mg_kept kept;  /* what fcm__mg_create_from() took from the earlier hierarchy */
   int values_pending; /* created on a pattern (fcm__mg_create_pattern()): no value set up yet */
+  long long setups;   /* fcm_mg_setup() calls since the creation (coarse_interval) */
   /* the space whose pattern level 0's matrix had at creation (fcm__mg_pattern_of()), NULL
    * for none; kept by fcm__mg_detach(), only compared */
   const fcm_space *pattern_of;
@@ -306,8 +307,10 @@ fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned
 /* ---- sweeps.c */
 
 /* One smoothing step with the pointwise smoother of m's options, by the team of the enclosing
- * parallel region (no barrier at the end). */
-void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x);
+ * parallel region (no barrier at the end); post: 0 before the coarse correction, 1 after it
+ * (the direction of a one-way step, point_sweep; consecutive one-way steps need a barrier
+ * between them). */
+void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x, int post);
 
 /* A symmetric block Gauss-Seidel sweep over the level's blocks, by the team of the enclosing
  * parallel region (no barrier at the end). */

@@ -37,6 +37,8 @@ fcm_mg_options fcm_mg_options_default(void)
   o.block_smoothing = 1;
   o.blocks = FCM_MG_BLOCKS_ALL;
   o.block_sweep = 0;
+  o.point_sweep = 0;
+  o.coarse_interval = 1;
   return o;
 }
 
@@ -131,19 +133,40 @@ cleanup:
   return st;
 }
 
-static fcm_status level0_dinv(fcm_mg *m)
+/* Level 0's rows checked against the eliminated rows of the creation (a row is eliminated
+ * when its off-diagonal entries are all zero) and its diagonal inverses, in one pass over the
+ * matrix by the team. */
+static fcm_status level0_values(fcm_mg *m)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   mg_level *L = &m->lev[0];
+  const fcm_index *rp = fcm_csr_row_ptr(L->A);
+  const int *ci = fcm_csr_col_idx(L->A);
   const double *v = fcm_csr_values_read(L->A);
-  for (fcm_index i = 0; i < L->n; i++) {
+  const fcm_index n = L->n;
+  fcm_index bad = n, bad_diag = n; /* the first row whose elimination changed, the first
+                                      non-positive diagonal */
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static)                             \
+    reduction(min                                                                                  \
+              : bad, bad_diag) if (n > 4096)
+  for (fcm_index i = 0; i < n; i++) {
+    int off = 0;
+    for (fcm_index p = rp[i]; p < rp[i + 1] && !off; p++)
+      off = ci[p] != i && v[p] != 0.0;
+    if (off != !L->inactive[i] && i < bad) bad = i;
     const double d = v[L->diag[i]];
-    FCM_CHECK(isfinite(d) && d > 0.0, ctx, FCM_ERR_NUMERIC,
-              "mg: diagonal entry of row %lld is %g (A must be positive definite)", (long long)i,
-              d);
+    if (!(isfinite(d) && d > 0.0) && i < bad_diag) bad_diag = i;
     L->dinv[i] = 1.0 / d;
   }
+  FCM_CHECK(bad == n, ctx, FCM_ERR_ARG,
+            "mg_setup: row %lld is %s now but was %s at creation (the eliminated rows "
+            "must not change: create the multigrid again)",
+            (long long)bad, L->inactive[bad] ? "coupled" : "eliminated",
+            L->inactive[bad] ? "eliminated" : "coupled");
+  FCM_CHECK(bad_diag == n, ctx, FCM_ERR_NUMERIC,
+            "mg: diagonal entry of row %lld is %g (A must be positive definite)",
+            (long long)bad_diag, v[L->diag[bad_diag]]);
 cleanup:
   return st;
 }
@@ -227,6 +250,13 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_mg_options *opts, fcm_mg
             "mg_create: blocks = %d is not a fcm_mg_blocks", (int)o.blocks);
   FCM_CHECK(o.block_sweep == 0 || o.block_sweep == 1, ctx, FCM_ERR_ARG,
             "mg_create: block_sweep = %d is neither 0 (symmetric) nor 1 (one way)", o.block_sweep);
+  FCM_CHECK(o.point_sweep == 0 || o.point_sweep == 1, ctx, FCM_ERR_ARG,
+            "mg_create: point_sweep = %d is neither 0 (symmetric) nor 1 (one way)", o.point_sweep);
+  FCM_CHECK(o.coarse_interval >= 1, ctx, FCM_ERR_ARG,
+            "mg_create: coarse_interval = %d must be >= 1", o.coarse_interval);
+  FCM_CHECK(o.point_sweep == 0 || o.smoother == FCM_MG_SMOOTHER_SGS, ctx, FCM_ERR_ARG,
+            "mg_create: point_sweep = 1 (one way) needs the SGS smoother (smoother = %d)",
+            (int)o.smoother);
   *out = o;
 cleanup:
   return st;
@@ -365,42 +395,33 @@ cleanup:
   return st;
 }
 
+/* Level l's block smoother on its matrix's values: after a set-up of this hierarchy (or its
+ * creation with values) the positions of the blocks' entries were checked against the pattern,
+ * which a set-up keeps (the Galerkin plans rely on it too), so they are not checked again. */
+static fcm_status setup_blocks(fcm_mg *m, int l)
+{
+  const fcm_csr *A = fcm__mg_level_matrix(&m->lev[l]);
+  return m->values_pending ? fcm_schwarz_setup(m->lev[l].blk, A)
+                           : fcm__schwarz_setup_known(m->lev[l].blk, A);
+}
+
 fcm_status fcm_mg_setup(fcm_mg *m)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m ? m->ctx : NULL;
   FCM_CHECK(m, ctx, FCM_ERR_ARG, "mg_setup: NULL argument");
-  {
-    mg_level *L = &m->lev[0];
-    const fcm_index *rp = fcm_csr_row_ptr(L->A);
-    const int *ci = fcm_csr_col_idx(L->A);
-    const double *v = fcm_csr_values_read(L->A);
-    const fcm_index n = L->n;
-    fcm_index bad = n; /* the first row whose elimination changed */
-#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static)                             \
-    reduction(min                                                                                  \
-              : bad) if (n > 4096)
-    for (fcm_index i = 0; i < n; i++) {
-      int off = 0;
-      for (fcm_index p = rp[i]; p < rp[i + 1] && !off; p++)
-        off = ci[p] != i && v[p] != 0.0;
-      if (off != !L->inactive[i] && i < bad) bad = i;
-    }
-    FCM_CHECK(bad == n, ctx, FCM_ERR_ARG,
-              "mg_setup: row %lld is %s now but was %s at creation (the eliminated rows "
-              "must not change: create the multigrid again)",
-              (long long)bad, L->inactive[bad] ? "coupled" : "eliminated",
-              L->inactive[bad] ? "eliminated" : "coupled");
+  /* the coarser levels at the first set-up and every coarse_interval-th after it */
+  const int coarse = m->values_pending || m->setups % m->opts.coarse_interval == 0;
+  FCM_TRY(ctx, level0_values(m));
+  for (int l = 0; l + 1 < m->nlev && (l == 0 || coarse); l++) {
+    if (m->lev[l].blk) FCM_TRY(ctx, setup_blocks(m, l));
+    if (coarse) FCM_TRY(ctx, galerkin_values(m, l));
   }
-  FCM_TRY(ctx, level0_dinv(m));
-  for (int l = 0; l + 1 < m->nlev; l++) {
-    if (m->lev[l].blk)
-      FCM_TRY(ctx, fcm_schwarz_setup(m->lev[l].blk, fcm__mg_level_matrix(&m->lev[l])));
-    FCM_TRY(ctx, galerkin_values(m, l));
-  }
-  FCM_TRY(ctx, fcm_direct_factor(m->direct,
-                                 fcm_csr_values_read(fcm__mg_level_matrix(&m->lev[m->nlev - 1]))));
+  if (coarse)
+    FCM_TRY(ctx, fcm_direct_factor(
+                     m->direct, fcm_csr_values_read(fcm__mg_level_matrix(&m->lev[m->nlev - 1]))));
   m->values_pending = 0;
+  m->setups++;
 cleanup:
   return st;
 }

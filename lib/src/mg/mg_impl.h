@@ -68,6 +68,11 @@ fcm_status fcm__mg_smooth_paths(fcm_mg *mg, int level, const double *b, const do
 void fcm__mg_block_apply_paths(const double *S, int m, int factor, double *r, double *dx_fast,
                                double *dx_plain);
 
+/* r = b - A x with level 0's matrix A, the threads of the hierarchy's team: each row's sum
+ * in fcm_csr_apply()'s order, so r equals b + fcm_csr_apply(A, -1, x, 0, .) bit for bit. */
+FCM_COMPONENT_API void fcm__mg_residual(const fcm_mg *m, const double *b, const double *x,
+                                        double *r);
+
 /* What fcm__mg_create_from() took from the earlier hierarchy (zero for fcm_mg_create()). */
 typedef struct fcm__mg_kept {
   int plans;           /* levels whose Galerkin plan, coarse pattern and positions were kept */

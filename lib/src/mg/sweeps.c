@@ -274,6 +274,49 @@ static void row_sweep_split(const slab_order *S, const sweep_args *a)
   sgs_slab(a, 1, 1);
 }
 
+/* One way through the slab order S by the team: forward, the slabs of the colour swept first
+ * and then the other's (a barrier between); backward, the reverse, its adjoint. No barrier at
+ * the end. */
+static void one_way_sweep(const slab_order *S,
+                          void (*slab)(const sweep_args *a, fcm_index s, int back),
+                          const sweep_args *a, int back)
+{
+  const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+  for (int pass = 0; pass < 2; pass++) {
+    const int c = (pass == 0) != back ? S->first : 1 - S->first;
+    if (pass == 1) {
+#pragma omp barrier
+    }
+    for (fcm_index k = c; k < S->nslab; k += 2)
+      if (fcm__mg_slab_mine(S, k, t, nt)) slab(a, k, back);
+  }
+}
+
+/* one_way_sweep() of a row order of three slabs by a team of two as row_sweep_split(): forward,
+ * slab 0's lead beside the thin slab 1, then the rest of slab 0 beside slab 2; backward, the
+ * reverse (slab 0 down to its tail beside slab 2, then the tail's rows beside slab 1). The same
+ * updates in the same order where they touch one another as one_way_sweep(), so the same
+ * iterate. No barrier at the end. */
+static void row_sweep_split_one_way(const slab_order *S, const sweep_args *a, int back)
+{
+  const fcm_index p0 = S->ptr[0], p1 = S->ptr[1];
+  if (omp_get_thread_num() == 0) {
+    if (!back) {
+      sgs_range(a, p0, p0 + S->lead, 0);
+#pragma omp barrier
+      sgs_range(a, p0 + S->lead, p1, 0);
+    } else {
+      sgs_range(a, p0 + S->tail, p1, 1);
+#pragma omp barrier
+      sgs_range(a, p0, p0 + S->tail, 1);
+    }
+    return;
+  }
+  sgs_slab(a, back ? 2 : 1, back);
+#pragma omp barrier
+  sgs_slab(a, back ? 1 : 2, back);
+}
+
 /* Does row_sweep_split() apply to S in the enclosing team: three slabs, the thin one first,
  * a lead, two threads owning the slabs as it assumes? */
 static int row_split_applies(const slab_order *S)
@@ -286,9 +329,11 @@ static int row_split_applies(const slab_order *S)
 /* One smoothing step. SGS: a forward then a backward sweep, S = (I - B^-1 A)(I - F^-1 A),
  * which is A-self-adjoint (B = F^T); pre- and post-smoothing both apply S, so the cycle is
  * symmetric (post-smoothing must be the adjoint of pre-smoothing: backward-then-forward
- * would not be). SGS runs in the slab order of the rows (symmetric_sweep()), the coloured
- * SGS colour after colour (a barrier each), Jacobi in two loops over the rows. */
-void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
+ * would not be). With point_sweep one way, the forward sweep alone before the coarse
+ * correction (post = 0) and the backward one, its adjoint, after it (post = 1). SGS runs in the
+ * slab order of the rows (symmetric_sweep()), the coloured SGS colour after colour (a barrier
+ * each), Jacobi in two loops over the rows. */
+void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x, int post)
 {
   const fcm_csr *A = fcm__mg_level_matrix(L);
   const fcm_index *rp = fcm_csr_row_ptr(A);
@@ -325,6 +370,13 @@ void fcm__mg_smooth(const fcm_mg *m, mg_level *L, const double *b, double *x)
     return;
   }
   const sweep_args a = {L, w, b, x, NULL, NULL, {0}, 0};
+  if (m->opts.point_sweep) {
+    if (row_split_applies(&L->rows))
+      row_sweep_split_one_way(&L->rows, &a, post);
+    else
+      one_way_sweep(&L->rows, sgs_slab, &a, post);
+    return;
+  }
   if (row_split_applies(&L->rows))
     row_sweep_split(&L->rows, &a);
   else
@@ -379,24 +431,6 @@ static void block_slab(const sweep_args *a, fcm_index s, int back)
       sym_lower_apply(S, r, bm, dx);
     for (int i = 0; i < bm; i++)
       x[d[i]] += dx[i];
-  }
-}
-
-/* One way through the slab order S by the team: forward, the slabs of the colour swept first
- * and then the other's (a barrier between); backward, the reverse, its adjoint. No barrier at
- * the end. */
-static void one_way_sweep(const slab_order *S,
-                          void (*slab)(const sweep_args *a, fcm_index s, int back),
-                          const sweep_args *a, int back)
-{
-  const int t = omp_get_thread_num(), nt = omp_get_num_threads();
-  for (int pass = 0; pass < 2; pass++) {
-    const int c = (pass == 0) != back ? S->first : 1 - S->first;
-    if (pass == 1) {
-#pragma omp barrier
-    }
-    for (fcm_index k = c; k < S->nslab; k += 2)
-      if (fcm__mg_slab_mine(S, k, t, nt)) slab(a, k, back);
   }
 }
 

@@ -86,9 +86,9 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
                                  fcm_integrator_options *s)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"smoother",        "omega",  "pre_smooth",
-                                     "post_smooth",     "cycle",  "coarse_dofs",
-                                     "block_smoothing", "blocks", "block_sweep"};
+  static const char *const keys[] = {"smoother",    "omega",       "pre_smooth",      "post_smooth",
+                                     "cycle",       "coarse_dofs", "block_smoothing", "blocks",
+                                     "block_sweep", "point_sweep", "coarse_interval"};
   fcm_mg_options *m = &s->multigrid;
   size_t old = SCENE_ENTER(p, "multigrid");
   long long coarse = (long long)m->coarse_dofs;
@@ -114,6 +114,14 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
   SCENE_READ_CHOICE_AS(p, mg, "blocks", 0, blocks_names, blocks_values, m->blocks);
   SCENE_READ_CHOICE_AS(p, mg, "block_sweep", 0, block_sweep_names, block_sweep_values,
                        m->block_sweep);
+  SCENE_READ_CHOICE_AS(p, mg, "point_sweep", 0, block_sweep_names, block_sweep_values,
+                       m->point_sweep);
+  SCENE_READ_INT(p, mg, "coarse_interval", 0, 1, 1000000, m->coarse_interval);
+  if (m->point_sweep && m->smoother != FCM_MG_SMOOTHER_SGS) {
+    fcm__scene_path_push_key(p, "point_sweep");
+    SCENE_CHECK(0, p, FCM_ERR_ARG,
+                "expected \"symmetric\": \"one_way\" needs the \"sgs\" smoother");
+  }
   SCENE_CHECK(m->pre_smooth + m->post_smooth >= 1, p, FCM_ERR_ARG,
               "pre_smooth = %d and post_smooth = %d: at least one smoothing step is needed",
               m->pre_smooth, m->post_smooth);

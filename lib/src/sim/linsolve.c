@@ -488,9 +488,13 @@ static fcm_status mg_solve(fcm_integrator *I, const double *b, double *d, fcm_st
     if (s != FCM_OK) break;
     k++;
     if (fixed > 0 && k < fixed) continue; /* no test between the fixed cycles */
-    FCM_TRY(ctx, fcm_csr_apply(I->H, -1.0, d, 0.0, I->mg_r));
-    for (fcm_index i = 0; i < n; i++)
-      I->mg_r[i] += b[i];
+    if (I->mg_A == I->H) {                /* the same bits, three rows at a time */
+      fcm__mg_residual(I->mg, b, d, I->mg_r);
+    } else {
+      FCM_TRY(ctx, fcm_csr_apply(I->H, -1.0, d, 0.0, I->mg_r));
+      for (fcm_index i = 0; i < n; i++)
+        I->mg_r[i] += b[i];
+    }
     rk = norm2(n, I->mg_r);
     if (k == 1) r1 = rk;
     if (!isfinite(rk) || rk > 1e3 * bn) {

@@ -174,8 +174,18 @@ static fcm_status evaluate(fcm_integrator *I, double h, const double *x, int tan
     if (h > 0.0) {
       for (fcm_index i = 0; i < n; i++)
         I->w1[i] = x[i] - I->uhat[i];
-      /* with a backend M is this process's partial matrix: sum the product (n doubles) */
-      st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->w2);
+      /* with a backend M is this process's partial matrix: sum the product (n doubles); at the
+       * initial guess itself (x = u^, the first evaluation of a step) M 0 = +0 (each row's sum
+       * of signed zeros from +0), which the product is not needed for */
+      int at_guess = 1;
+      for (fcm_index i = 0; i < n && at_guess; i++)
+        at_guess = I->w1[i] == 0.0;
+      if (at_guess) {
+        memset(I->w2, 0, sizeof *I->w2 * (size_t)n);
+        st = FCM_OK;
+      } else {
+        st = fcm__space_matrix_apply(I->space, I->M, I->w1, I->w2);
+      }
       FCM_TRY(I->ctx, fcm__integrator_reduce_status(I, st, I->w2, n));
       const double a = fcm__sim_mass_coeff(I, h);
       inertia = 0.5 * a * dot(n, I->w1, I->w2);

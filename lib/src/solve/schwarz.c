@@ -209,9 +209,11 @@ static int gather_scan(const fcm_csr *C, const double *vals, int m, const fcm_in
 /* Gather C_K's lower triangle (all that the Cholesky factor and dsyevd read) through the
  * positions of a block whose entries are all stored (pos of gather_scan()), each checked
  * against C's pattern, entry (i, j) into a[(i + j m) stride]: 1 when all finite, 0 when one is
- * NaN or infinite, -1 (a unfinished) when C's pattern has moved an entry. */
+ * NaN or infinite, -1 (a unfinished) when C's pattern has moved an entry. known: C's pattern is
+ * the one the positions were found on (fcm__schwarz_setup_known()): its columns are not read
+ * again. */
 static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_index *d,
-                        const int *pos, double *a, size_t stride)
+                        const int *pos, double *a, size_t stride, int known)
 {
   const fcm_index *rp = fcm_csr_row_ptr(C);
   const int *ci = fcm_csr_col_idx(C);
@@ -221,7 +223,7 @@ static int gather_known(const fcm_csr *C, const double *vals, int m, const fcm_i
     const int *pi = pos + FCM__SCHWARZ_PACKED(i, 0);
     for (int j = 0; j <= i; j++) {
       const fcm_index p = r0 + pi[j];
-      if (pi[j] >= len || ci[p] != d[j]) return -1;
+      if (pi[j] >= len || (!known && ci[p] != d[j])) return -1;
       finite &= isfinite(vals[p]) != 0;
       a[(i + (size_t)j * m) * stride] = vals[p];
     }
@@ -462,13 +464,13 @@ static inline __attribute__((always_inline)) void cholesky_invert_factor4(int m,
  * per-CPU clones (core/multiversion.h: the same roundings). */
 FCM_MULTIVERSION_CLONES
 static unsigned build_batch(fcm_schwarz *P, const fcm_csr *C, const double *vals, fcm_index b,
-                            int m, double *w)
+                            int m, double *w, int known)
 {
   const size_t mm = (size_t)m * (size_t)m;
   v4d *a = (v4d *)w, *L = a + mm, *X = L + mm;
   for (int q = 0; q < BATCH; q++)
     if (gather_known(C, vals, m, P->dofs + P->block_ptr[b + q], P->pos + P->pos_off[b + q], w + q,
-                     BATCH) != 1)
+                     BATCH, known) != 1)
       return 0;
   unsigned bad = 0, done = 0;
   cholesky_factor4(m, a, L, &bad);
@@ -500,7 +502,7 @@ static unsigned build_batch(fcm_schwarz *P, const fcm_csr *C, const double *vals
  * eigendecomposition with reflected and clamped eigenvalues. */
 static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *vals, fcm_index b,
                               int *loc, double *a, double *w, double *lw, int *iw, block_stats *bs,
-                              block_fail *fail)
+                              block_fail *fail, int known)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P->ctx;
@@ -508,7 +510,7 @@ static fcm_status build_block(fcm_schwarz *P, const fcm_csr *C, const double *va
   const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
   double *S = P->S + P->s_off[b];
   int *pos = P->pos + P->pos_off[b];
-  int finite = P->full[b] ? gather_known(C, vals, m, d, pos, a, 1) : -1;
+  int finite = P->full[b] ? gather_known(C, vals, m, d, pos, a, 1, known) : -1;
   if (finite < 0) finite = gather_scan(C, vals, m, d, loc, pos, P->full + b, a);
   if (!finite) {
     *fail = FAIL_NONFINITE;
@@ -579,7 +581,8 @@ cleanup:
   return st;
 }
 
-fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
+/* fcm_schwarz_setup(); known: C's pattern is the one of the last set-up (only values changed). */
+static fcm_status setup(fcm_schwarz *P, const fcm_csr *C, int known)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = P ? P->ctx : NULL;
@@ -615,12 +618,12 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
       int same = P->factor && b1 - b0 == BATCH;
       for (fcm_index b = b0; same && b < b1; b++)
         same = P->full[b] && P->block_ptr[b + 1] - P->block_ptr[b] == m;
-      const unsigned done = same ? build_batch(P, C, vals, b0, m, a + P->scalar_work) : 0u;
+      const unsigned done = same ? build_batch(P, C, vals, b0, m, a + P->scalar_work, known) : 0u;
       for (fcm_index b = b0; b < b1; b++) {
         if ((done >> (b - b0)) & 1u) continue;
         block_stats bs = {0, 0};
         block_fail fail = FAIL_NONE;
-        fcm_status s = build_block(P, C, vals, b, loc, a, w, lw, iw, &bs, &fail);
+        fcm_status s = build_block(P, C, vals, b, loc, a, w, lw, iw, &bs, &fail, known);
         negative += bs.negative;
         clamped += bs.clamped;
         if (s != FCM_OK) {
@@ -657,6 +660,16 @@ fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
   P->ready = 1;
 cleanup:
   return st;
+}
+
+fcm_status fcm_schwarz_setup(fcm_schwarz *P, const fcm_csr *C)
+{
+  return setup(P, C, 0);
+}
+
+fcm_status fcm__schwarz_setup_known(fcm_schwarz *P, const fcm_csr *C)
+{
+  return setup(P, C, 1);
 }
 
 /* Do block rows i, i + 1, i + 2 hold a node's three DOFs (d[i] = 3 k, d[i + 1] = 3 k + 1,

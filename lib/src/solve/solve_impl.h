@@ -19,6 +19,11 @@
  * block k's slot. */
 #define FCM__SCHWARZ_PACKED(i, j) ((size_t)(i) * ((size_t)(i) + 1) / 2 + (size_t)(j))
 fcm_index fcm__schwarz_num_blocks(const fcm_schwarz *P);
+/* fcm_schwarz_setup() on a matrix whose pattern is the one of P's last set-up (the same
+ * row_ptr and col_idx contents; only the values changed), as the multigrid's levels have
+ * between creations: the blocks' entries are taken through the positions found before
+ * without reading C's columns again. The same result as fcm_schwarz_setup(). */
+fcm_status fcm__schwarz_setup_known(fcm_schwarz *P, const fcm_csr *C);
 int fcm__schwarz_block(const fcm_schwarz *P, fcm_index k, const fcm_index **dofs, const double **S);
 size_t fcm__schwarz_slot_size(const fcm_schwarz *P, fcm_index k);
 /* 1 when block k of a block smoother (fcm__schwarz_create_blocks()) holds, in S's place, the
