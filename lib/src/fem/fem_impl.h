@@ -21,7 +21,7 @@ typedef struct fcm__space_mass_cache {
   double *blocks;
 } fcm__space_mass_cache;
 
-/* Local elements per block of assembly's visiting order (block_color_ptr, block_list). */
+/* Cells per block of assembly's visiting order (block_ptr, block_color_ptr, block_list). */
 enum { FCM__SPACE_BLOCK = 128 };
 
 struct fcm_space {
@@ -93,13 +93,18 @@ struct fcm_space {
   int num_colors;
   fcm_index *color_ptr;
   fcm_index *color_elems;
-  /* Assembly's visiting order: block_elems lists the local element positions in the Morton
-   * order of their cells' centres; block b is its entries [b B, min((b + 1) B,
-   * num_local_elems)) (B = FCM__SPACE_BLOCK), a compact cluster of cells. The blocks are
-   * coloured so that no two of a colour share a copy: block_color_ptr[c]..block_color_ptr[c+1]
-   * index block_list, the blocks of colour c ascending. One thread assembles a whole block, so
-   * neighbouring cells follow each other and their matrix rows are still in cache
-   * (assemble.c). */
+  /* Assembly's visiting order: block_cells lists the cells with local elements (a full
+   * space: the active cells) in the Morton order of their centres; block b holds the cells
+   * [b B, min((b + 1) B, num_block_cells)) of it (B = FCM__SPACE_BLOCK), a compact cluster,
+   * and their local elements block_elems[block_ptr[b] .. block_ptr[b + 1]) (cell by cell, each
+   * cell's elements ascending). The blocks are coloured so that no two of a colour share a mesh
+   * node of their cells (or the node of a copy a constrained element uses in another node's
+   * place): block_color_ptr[c]..block_color_ptr[c+1] index block_list, the blocks of colour c
+   * ascending. One thread assembles a whole block, so neighbouring cells follow each other and
+   * their matrix rows are still in cache (assemble.c). The blocks and their colours depend on
+   * the active cells alone (and the constrained elements' copies): a cut, which adds elements
+   * to the cells it reaches, changes neither, so every element away from the cut keeps its
+   * place in the visit. */
   int num_block_colors;
   /* Copy graph rows fcm__space_build_topology_cut() took from the space before the cut (0: the
    * topology was built anew) */
@@ -107,6 +112,12 @@ struct fcm_space {
   fcm_index *block_color_ptr;
   fcm_index *block_list;
   fcm_index *block_elems; /* num_local_elems */
+  fcm_index num_blocks, num_block_cells;
+  fcm_index *block_ptr;   /* num_blocks + 1 */
+  fcm_index *block_cells; /* num_block_cells */
+  /* 1 when fcm__space_build_topology_cut() took block_cells and the block colours from the
+   * space before the cut */
+  int blocks_kept;
   /* Embedded case: per-cell rules of cut cells (borrowed) and the most points any cut
    * cell has in either rule. Nothing here changes after creation: assembly scratch lives
    * in fcm_assembly_workspace (assemble.c). */

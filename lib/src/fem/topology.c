@@ -248,17 +248,17 @@ cleanup:
   return st;
 }
 
-/* A local element position with the Morton key of its cell's centre. */
-typedef struct morton_elem {
+/* A cell with the Morton key of its centre. */
+typedef struct morton_cell {
   uint64_t key;
-  fcm_index le;
-} morton_elem;
+  fcm_index cell;
+} morton_cell;
 
 static int cmp_morton(const void *a, const void *b)
 {
-  const morton_elem *x = a, *y = b;
+  const morton_cell *x = a, *y = b;
   if (x->key != y->key) return (x->key > y->key) - (x->key < y->key);
-  return (x->le > y->le) - (x->le < y->le);
+  return (x->cell > y->cell) - (x->cell < y->cell);
 }
 
 /* The 21 low bits of v spread to every third bit. */
@@ -283,90 +283,185 @@ uint64_t fcm__morton_key(const double x[3], const double lo[3], const double hi[
   return key;
 }
 
-/* block_elems: the local element positions in the Morton (Z-curve) order of their cells'
- * centres on a 2^21 grid over the elements' bounding box (ties, the pieces of one cell, by
- * position), so that runs of FCM__SPACE_BLOCK of them are compact clusters of cells. */
-static fcm_status build_block_order(fcm_space *s)
+/* 1 when cell c takes part in the blocks: active, and local in a local space. */
+static int block_cell(const fcm_space *s, fcm_index c)
+{
+  return s->cell_local ? s->cell_local[c] != 0 : s->active[c] != 0;
+}
+
+/* block_cells: the cells of the blocks in the Morton (Z-curve) order of their centres on a
+ * 2^21 grid over the centres' bounding box (ties by cell id), so that runs of
+ * FCM__SPACE_BLOCK of them are compact clusters. */
+static fcm_status build_block_cells(fcm_space *s)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_index ne = s->num_local_elems;
   const int nn = s->nn;
-  morton_elem *m = NULL;
+  fcm_index nbc = 0;
+  morton_cell *m = NULL;
   double *ctr = NULL, X[3 * FCM_ELEMENT_MAX_NODES], lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
          hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  FCM_ALLOC(ctx, ne + 1, m);
-  FCM_ALLOC(ctx, 3 * ne + 1, ctr);
-  for (fcm_index e = 0; e < ne; e++) {
-    fcm_mesh_cell_coords(s->mesh, s->elem_cell[local_elem(s, e)], X);
+  for (fcm_index c = 0; c < s->num_cells; c++)
+    nbc += block_cell(s, c);
+  FCM_ALLOC(ctx, nbc + 1, m);
+  FCM_ALLOC(ctx, 3 * nbc + 1, ctr);
+  for (fcm_index c = 0, i = 0; c < s->num_cells; c++) {
+    if (!block_cell(s, c)) continue;
+    fcm_mesh_cell_coords(s->mesh, c, X);
     for (int d = 0; d < 3; d++) {
-      double c = 0.0;
+      double x = 0.0;
       for (int a = 0; a < nn; a++)
-        c += X[3 * a + d];
-      ctr[3 * e + d] = c / nn;
-      lo[d] = fmin(lo[d], c / nn), hi[d] = fmax(hi[d], c / nn);
+        x += X[3 * a + d];
+      ctr[3 * i + d] = x / nn;
+      lo[d] = fmin(lo[d], x / nn), hi[d] = fmax(hi[d], x / nn);
     }
+    m[i++].cell = c;
   }
-  for (fcm_index e = 0; e < ne; e++)
-    m[e].key = fcm__morton_key(ctr + 3 * e, lo, hi), m[e].le = e;
-  qsort(m, (size_t)ne, sizeof *m, cmp_morton);
-  FCM_ALLOC(ctx, ne + 1, s->block_elems);
-  for (fcm_index e = 0; e < ne; e++)
-    s->block_elems[e] = m[e].le;
+  for (fcm_index i = 0; i < nbc; i++)
+    m[i].key = fcm__morton_key(ctr + 3 * i, lo, hi);
+  qsort(m, (size_t)nbc, sizeof *m, cmp_morton);
+  FCM_ALLOC(ctx, nbc + 1, s->block_cells);
+  for (fcm_index i = 0; i < nbc; i++)
+    s->block_cells[i] = m[i].cell;
+  s->num_block_cells = nbc;
+  s->num_blocks = (nbc + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
 cleanup:
   fcm__free(ctx, m);
   fcm__free(ctx, ctr);
   return st;
 }
 
-/* build_block_order() of a full space s after a cut from the full space `from` whose active cells
- * are s's: the cells' centres and their box are the same, so the Morton keys are, and the
- * elements of a cell (one key, ascending positions) follow each other in both orders; the cut
- * only changes how many elements each cell has. So each run of a cell's elements in from's
- * order becomes the run of its elements in s. *done = 0 (nothing made) when the active cells
- * differ. */
-static fcm_status patch_block_order(fcm_space *s, const fcm_space *from, int *done)
-{
-  fcm_status st = FCM_OK;
-  fcm_index *order = NULL, j = 0;
-  *done = 0;
-  if (from->num_cells != s->num_cells || !from->block_elems || from->local_elem || s->local_elem ||
-      memcmp(from->active, s->active, (size_t)s->num_cells) != 0)
-    return FCM_OK;
-  FCM_ALLOC_RAW(s->ctx, s->num_elems + 1, order);
-  for (fcm_index i = 0; i < from->num_elems; i++) {
-    const fcm_index fe = from->block_elems[i], c = from->elem_cell[fe];
-    if (fe != from->cell_elem[c]) continue; /* the cell's run was written at its first */
-    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1] && j < s->num_elems; e++)
-      order[j++] = e;
-  }
-  if (j == s->num_elems) { /* every active cell has elements in both */
-    s->block_elems = order;
-    order = NULL;
-    *done = 1;
-  }
-cleanup:
-  fcm__free(s->ctx, order);
-  return st;
-}
-
-/* Greedy colouring of the blocks of FCM__SPACE_BLOCK consecutive entries of block_elems: a
- * block takes the smallest colour not used by a block with an element sharing a copy with one
- * of its own. */
-static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
-                                     const fcm_index *cinc, const fcm_space *from)
+/* block_ptr and block_elems from block_cells: each block's cells' local elements, cell by
+ * cell. */
+static fcm_status build_block_elems(fcm_space *s)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_index ne = s->num_local_elems, nb = (ne + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
+  const fcm_index nb = s->num_blocks, nbc = s->num_block_cells;
+  fcm_index *first = NULL, j = 0; /* a local space: the first local position of each cell */
+  if (s->local_elem) {
+    FCM_ALLOC_RAW(ctx, (size_t)s->num_cells + 1, first);
+    for (fcm_index le = s->num_local_elems - 1; le >= 0; le--)
+      first[s->elem_cell[s->local_elem[le]]] = le;
+  }
+  FCM_ALLOC_RAW(ctx, (size_t)nb + 1, s->block_ptr);
+  FCM_ALLOC_RAW(ctx, (size_t)s->num_local_elems + 1, s->block_elems);
+  s->block_ptr[0] = 0;
+  for (fcm_index b = 0; b < nb; b++) {
+    for (fcm_index i = b * FCM__SPACE_BLOCK; i < FCM_MIN(nbc, (b + 1) * FCM__SPACE_BLOCK); i++) {
+      const fcm_index c = s->block_cells[i], n = s->cell_elem[c + 1] - s->cell_elem[c];
+      const fcm_index e0 = first ? first[c] : s->cell_elem[c];
+      for (fcm_index e = 0; e < n && j < s->num_local_elems; e++)
+        s->block_elems[j++] = e0 + e;
+    }
+    s->block_ptr[b + 1] = j;
+  }
+  FCM_CHECK(j == s->num_local_elems, ctx, FCM_ERR_INTERNAL,
+            "space: the blocks hold %lld of the %lld local elements", (long long)j,
+            (long long)s->num_local_elems);
+cleanup:
+  fcm__free(ctx, first);
+  return st;
+}
+
+/* The mesh nodes block b touches, each once (mark[n] == b once seen), into nodes (NULL:
+ * counted only): its cells' nodes and the nodes of the copies its elements use in another
+ * node's place (constrained copies, node_of). Returns their number. */
+static fcm_index block_nodes(const fcm_space *s, fcm_index b, const fcm_index *node_of,
+                             fcm_index *mark, fcm_index *nodes)
+{
+  const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  const fcm_index nbc = s->num_block_cells;
+  fcm_index cnt = 0;
+  for (fcm_index i = b * FCM__SPACE_BLOCK; i < FCM_MIN(nbc, (b + 1) * FCM__SPACE_BLOCK); i++)
+    for (int a = 0; a < s->nn; a++) {
+      const fcm_index n = cells[s->block_cells[i] * s->nn + a];
+      if (mark[n] == b) continue;
+      mark[n] = b;
+      if (nodes) nodes[cnt] = n;
+      cnt++;
+    }
+  for (fcm_index j = s->block_ptr[b]; node_of && j < s->block_ptr[b + 1]; j++) {
+    const fcm_index e = local_elem(s, s->block_elems[j]);
+    for (int a = 0; a < s->nn; a++) {
+      if (!s->elem_con[e * s->nn + a]) continue;
+      const fcm_index n = node_of[s->elem_dof[e * s->nn + a] / 3];
+      if (mark[n] == b) continue;
+      mark[n] = b;
+      if (nodes) nodes[cnt] = n;
+      cnt++;
+    }
+  }
+  return cnt;
+}
+
+/* The nodes of each block (bn_ptr, bn) and the blocks at each node (nb_ptr, nbl, ascending). */
+typedef struct block_graph {
+  fcm_index *bn_ptr, *bn, *nb_ptr, *nbl;
+} block_graph;
+
+static fcm_status build_block_graph(const fcm_space *s, block_graph *g)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index nb = s->num_blocks, np = s->num_nodes;
+  fcm_index *mark = NULL, *node_of = NULL, *fill = NULL;
+  FCM_ALLOC_RAW(ctx, (size_t)np + 1, mark);
+  if (s->elem_con) { /* the node of each copy */
+    FCM_ALLOC_RAW(ctx, (size_t)s->num_dofs / 3 + 1, node_of);
+    for (fcm_index n = 0; n < np; n++)
+      for (fcm_index c = 0; c < s->node_ncopy[n]; c++)
+        node_of[s->node_dof[n] / 3 + c] = n;
+  }
+  for (fcm_index n = 0; n < np; n++)
+    mark[n] = -1;
+  FCM_ALLOC(ctx, nb + 1, g->bn_ptr);
+  for (fcm_index b = 0; b < nb; b++)
+    g->bn_ptr[b + 1] = g->bn_ptr[b] + block_nodes(s, b, node_of, mark, NULL);
+  FCM_ALLOC_RAW(ctx, (size_t)g->bn_ptr[nb] + 1, g->bn);
+  FCM_ALLOC(ctx, np + 1, g->nb_ptr);
+  for (fcm_index n = 0; n < np; n++)
+    mark[n] = -1;
+  for (fcm_index b = 0; b < nb; b++) {
+    block_nodes(s, b, node_of, mark, g->bn + g->bn_ptr[b]);
+    for (fcm_index i = g->bn_ptr[b]; i < g->bn_ptr[b + 1]; i++)
+      g->nb_ptr[g->bn[i] + 1]++;
+  }
+  for (fcm_index n = 0; n < np; n++)
+    g->nb_ptr[n + 1] += g->nb_ptr[n];
+  FCM_ALLOC_RAW(ctx, (size_t)g->nb_ptr[np] + 1, g->nbl);
+  FCM_ALLOC(ctx, np + 1, fill);
+  for (fcm_index b = 0; b < nb; b++)
+    for (fcm_index i = g->bn_ptr[b]; i < g->bn_ptr[b + 1]; i++)
+      g->nbl[g->nb_ptr[g->bn[i]] + fill[g->bn[i]]++] = b;
+cleanup:
+  fcm__free(ctx, mark);
+  fcm__free(ctx, node_of);
+  fcm__free(ctx, fill);
+  return st;
+}
+
+static void free_block_graph(fcm_ctx *ctx, block_graph *g)
+{
+  fcm__free(ctx, g->bn_ptr);
+  fcm__free(ctx, g->bn);
+  fcm__free(ctx, g->nb_ptr);
+  fcm__free(ctx, g->nbl);
+}
+
+/* Greedy colouring of the blocks: a block takes the smallest colour not used by a block
+ * touching one of its nodes (block_nodes()). Two elements sharing a copy touch its node, so
+ * blocks of one colour share no copy. */
+static fcm_status colour_blocks(fcm_space *s)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index nb = s->num_blocks;
   int *color = NULL, ncol = 0;
-  fcm_index *forbid = NULL, *fill = NULL, *block_of = NULL;
-  int patched = 0;
-  if (from) FCM_TRY(ctx, patch_block_order(s, from, &patched));
-  if (!patched) FCM_TRY(ctx, build_block_order(s));
-  FCM_ALLOC(ctx, ne + 1, block_of);
-  for (fcm_index j = 0; j < ne; j++)
-    block_of[s->block_elems[j]] = j / FCM__SPACE_BLOCK;
+  fcm_index *forbid = NULL, *fill = NULL;
+  block_graph g;
+  memset(&g, 0, sizeof g);
+  FCM_TRY(ctx, build_block_graph(s, &g));
   FCM_ALLOC(ctx, nb + 1, color);
   FCM_ALLOC(ctx, MAX_COLORS, forbid);
   for (int k = 0; k < MAX_COLORS; k++)
@@ -374,16 +469,10 @@ static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const f
   for (fcm_index b = 0; b < nb; b++)
     color[b] = -1;
   for (fcm_index b = 0; b < nb; b++) {
-    const fcm_index e1 = FCM_MIN(ne, (b + 1) * FCM__SPACE_BLOCK);
-    for (fcm_index j = b * FCM__SPACE_BLOCK; j < e1; j++) {
-      const fcm_index *ed = s->elem_dof + local_elem(s, s->block_elems[j]) * s->nn;
-      for (int a = 0; a < s->nn; a++) {
-        const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
-        for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
-          const int c = color[block_of[cinc[i]]];
-          if (c >= 0) forbid[c] = b;
-        }
-      }
+    for (fcm_index i = g.bn_ptr[b]; i < g.bn_ptr[b + 1]; i++) {
+      const fcm_index n = g.bn[i];
+      for (fcm_index j = g.nb_ptr[n]; j < g.nb_ptr[n + 1] && g.nbl[j] < b; j++)
+        forbid[color[g.nbl[j]]] = b;
     }
     int k = 0;
     while (k < MAX_COLORS && forbid[k] == b)
@@ -406,10 +495,49 @@ static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const f
   for (fcm_index b = 0; b < nb; b++)
     s->block_list[s->block_color_ptr[color[b]] + fill[color[b]]++] = b;
 cleanup:
+  free_block_graph(ctx, &g);
   fcm__free(ctx, color);
   fcm__free(ctx, forbid);
   fcm__free(ctx, fill);
-  fcm__free(ctx, block_of);
+  return st;
+}
+
+/* 1 when the full space s after a cut may take the blocks of the full space `from`: the same
+ * active cells (so the same block cells in the same order), neither with constrained copies
+ * (so the same nodes per block and the same colours). */
+static int can_keep_blocks(const fcm_space *s, const fcm_space *from)
+{
+  return from && from->block_cells && from->block_list && !from->local_elem && !s->local_elem &&
+         !from->cell_local && !s->cell_local && !from->elem_con && !s->elem_con &&
+         from->num_cells == s->num_cells &&
+         memcmp(from->active, s->active, (size_t)s->num_cells) == 0;
+}
+
+/* Assembly's blocks (block_cells, block_ptr, block_elems) and their colours; after a cut from
+ * the full space `from` the cells' order and the colours taken from it where
+ * can_keep_blocks(). */
+static fcm_status build_blocks(fcm_space *s, const fcm_space *from)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  s->blocks_kept = can_keep_blocks(s, from);
+  if (s->blocks_kept) {
+    const int ncol = from->num_block_colors;
+    s->num_block_cells = from->num_block_cells, s->num_blocks = from->num_blocks;
+    s->num_block_colors = ncol;
+    FCM_ALLOC_RAW(ctx, (size_t)s->num_block_cells + 1, s->block_cells);
+    FCM_ALLOC_RAW(ctx, (size_t)ncol + 1, s->block_color_ptr);
+    FCM_ALLOC_RAW(ctx, (size_t)s->num_blocks + 1, s->block_list);
+    memcpy(s->block_cells, from->block_cells, sizeof(fcm_index) * (size_t)s->num_block_cells);
+    memcpy(s->block_color_ptr, from->block_color_ptr, sizeof(fcm_index) * ((size_t)ncol + 1));
+    memcpy(s->block_list, from->block_list, sizeof(fcm_index) * (size_t)s->num_blocks);
+    FCM_TRY(ctx, build_block_elems(s));
+  } else {
+    FCM_TRY(ctx, build_block_cells(s));
+    FCM_TRY(ctx, build_block_elems(s));
+    FCM_TRY(ctx, colour_blocks(s));
+  }
+cleanup:
   return st;
 }
 
@@ -436,14 +564,17 @@ void fcm__space_free_topology(fcm_space *s)
   void *arrays[] = {s->node_ptr,   s->node_adj,    s->row_ptr,     s->col_idx,
                     s->elem_off,   s->elem_lcopy,  s->color_ptr,   s->color_elems,
                     s->local_copy, s->local_elem,  s->cell_local,  s->block_color_ptr,
-                    s->block_list, s->block_elems, s->cut_row_from};
+                    s->block_list, s->block_elems, s->cut_row_from, s->block_ptr,
+                    s->block_cells};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   s->node_ptr = s->node_adj = s->row_ptr = s->local_copy = s->local_elem = NULL;
   s->color_ptr = s->color_elems = NULL;
   s->col_idx = s->elem_off = s->elem_lcopy = NULL;
   s->cell_local = NULL;
-  s->block_color_ptr = s->block_list = s->block_elems = NULL;
+  s->block_color_ptr = s->block_list = s->block_elems = s->block_ptr = s->block_cells = NULL;
+  s->num_blocks = s->num_block_cells = 0;
+  s->blocks_kept = 0;
   s->cut_row_from = NULL, s->cut_from = NULL;
   s->cut_from_dofs = s->cut_from_elems = 0;
   s->num_colors = s->num_block_colors = 0;
@@ -498,7 +629,7 @@ fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned cha
   FCM_TRY(ctx, node_graph(s, g2l, cptr, cinc, NULL, NULL));
   FCM_TRY(ctx, build_pattern(s, g2l));
   FCM_TRY(ctx, build_colors(s, g2l, cptr, cinc));
-  FCM_TRY(ctx, build_block_colors(s, g2l, cptr, cinc, NULL));
+  FCM_TRY(ctx, build_blocks(s, NULL));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
   fcm__free(ctx, g2l);
@@ -738,9 +869,8 @@ static void visit_ranks(const fcm_space *s, fcm_index *rank)
   fcm_index r = 0;
   for (int c = 0; c < s->num_block_colors; c++)
     for (fcm_index k = s->block_color_ptr[c]; k < s->block_color_ptr[c + 1]; k++) {
-      const fcm_index first = s->block_list[k] * FCM__SPACE_BLOCK;
-      const fcm_index last = FCM_MIN(s->num_local_elems, first + FCM__SPACE_BLOCK);
-      for (fcm_index j = first; j < last; j++)
+      const fcm_index b = s->block_list[k];
+      for (fcm_index j = s->block_ptr[b]; j < s->block_ptr[b + 1]; j++)
         rank[s->block_elems[j]] = r++;
     }
 }
@@ -764,7 +894,10 @@ static int same_visit(const fcm_index *cinc, fcm_index i0, fcm_index i1, const f
 }
 
 /* s->cut_row_from: the copies whose rows are their parents' in the same order (copy_kept 2)
- * and whose elements keep their parents' order of visit. */
+ * and whose elements keep their parents' order of visit. With the blocks and colours taken
+ * from `from` (blocks_kept) every kept element keeps its place in the visit (the same cell, so
+ * the same block and colour and place among the block's cells, and the same place among its
+ * cell's elements), so the elements of a copy_kept copy, all kept, keep their order. */
 static fcm_status mark_cut_rows(fcm_space *s, const fcm_space *from, const fcm_index *cptr,
                                 const fcm_index *cinc, const cut_map *m)
 {
@@ -772,12 +905,20 @@ static fcm_status mark_cut_rows(fcm_space *s, const fcm_space *from, const fcm_i
   fcm_ctx *ctx = s->ctx;
   const fcm_index ncopy = s->num_dofs / 3;
   fcm_index *rank = NULL, *old_rank = NULL, *buf = NULL, most = 1;
+  FCM_ALLOC_RAW(ctx, (size_t)ncopy + 1, s->cut_row_from);
+  s->cut_from = from;
+  s->cut_from_dofs = from->num_dofs;
+  s->cut_from_elems = from->num_elems;
+  if (s->blocks_kept) {
+    for (fcm_index k = 0; k < ncopy; k++)
+      s->cut_row_from[k] = m->copy_kept[k] == 2 ? m->parent[k] : -1;
+    return FCM_OK;
+  }
   for (fcm_index k = 0; k < ncopy; k++)
     most = FCM_MAX(most, cptr[k + 1] - cptr[k]);
   FCM_ALLOC_RAW(ctx, (size_t)s->num_elems + 1, rank);
   FCM_ALLOC_RAW(ctx, (size_t)from->num_elems + 1, old_rank);
   FCM_ALLOC_RAW(ctx, (size_t)most, buf);
-  FCM_ALLOC_RAW(ctx, (size_t)ncopy + 1, s->cut_row_from);
   visit_ranks(s, rank);
   visit_ranks(from, old_rank);
   for (fcm_index k = 0; k < ncopy; k++)
@@ -785,9 +926,6 @@ static fcm_status mark_cut_rows(fcm_space *s, const fcm_space *from, const fcm_i
         m->copy_kept[k] == 2 && same_visit(cinc, cptr[k], cptr[k + 1], rank, old_rank, m, buf)
             ? m->parent[k]
             : -1;
-  s->cut_from = from;
-  s->cut_from_dofs = from->num_dofs;
-  s->cut_from_elems = from->num_elems;
 cleanup:
   fcm__free(ctx, rank);
   fcm__free(ctx, old_rank);
@@ -822,7 +960,7 @@ fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from, fc
   FCM_TRY(ctx, build_pattern_rows(s, give == from ? give : NULL));
   FCM_TRY(ctx, patch_offsets(s, from, &m));
   FCM_TRY(ctx, patch_colors(s, from, cptr, cinc, &m));
-  FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc, from));
+  FCM_TRY(ctx, build_blocks(s, from));
   FCM_TRY(ctx, mark_cut_rows(s, from, cptr, cinc, &m));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
