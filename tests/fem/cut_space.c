@@ -249,7 +249,7 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, nc, &mesh));
   TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
   run(mesh, g, fcm_space_options_default().constrain_ratio);
-  TEST_TRUE(run(mesh, g, 0.2) > 0);  /* tiny copies constrained */
+  TEST_TRUE(run(mesh, g, 0.2) > 0); /* tiny copies constrained */
   /* the tets' active cells make several blocks (the hexahedra's fit in one) */
   if (fcm_element_get_info(type)->num_corners == 4) TEST_TRUE(block_colors_swapped > 0);
   TEST_TRUE(run_take(mesh, g) >= 2); /* the third cut adds more than the room */

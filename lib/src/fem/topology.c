@@ -561,9 +561,9 @@ void fcm__space_free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
   fcm__space_cut_give_back(s);
-  void *arrays[] = {s->node_ptr,   s->node_adj,    s->row_ptr,     s->col_idx,
-                    s->elem_off,   s->elem_lcopy,  s->color_ptr,   s->color_elems,
-                    s->local_copy, s->local_elem,  s->cell_local,  s->block_color_ptr,
+  void *arrays[] = {s->node_ptr,   s->node_adj,    s->row_ptr,      s->col_idx,
+                    s->elem_off,   s->elem_lcopy,  s->color_ptr,    s->color_elems,
+                    s->local_copy, s->local_elem,  s->cell_local,   s->block_color_ptr,
                     s->block_list, s->block_elems, s->cut_row_from, s->block_ptr,
                     s->block_cells};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
