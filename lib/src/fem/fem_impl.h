@@ -414,6 +414,14 @@ fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_ind
  * (topology.c) */
 fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned char *cell_mask);
 
+/* Assembly's blocks of s (block_cells, block_ptr, block_elems) and their colours, the local
+ * elements (and, for a local space, local_elem and cell_local) made; with `from` (a full space
+ * before the cut of the full space s, NULL otherwise) the cells' order and the colours are taken
+ * from it where both have the same active cells and neither constrained copies: the same
+ * arrays as built anew. @return FCM_OK, FCM_ERR_ALLOC, FCM_ERR_UNSUPPORTED (colours),
+ * FCM_ERR_INTERNAL. (visit.c) */
+fcm_status fcm__space_build_blocks(fcm_space *s, const fcm_space *from);
+
 /* fcm__space_build_topology(s, 0, NULL) for a cut space s (full) from `from`, the full space
  * before the cut (s's rules made from from's by fcm_cell_rules_create_cut()): the graph rows
  * of the copies the cut left as they were (same elements, each the only child of its parent)
