@@ -417,8 +417,8 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
       memcpy(w->ue + 3 * a, kd->u + ed[a], 3 * sizeof(double));
   }
   if (kd->kind == KERNEL_COROT_LINEAR)
-    return fcm__corot_kernel(kd, kd->corot_K + (size_t)e * kd->corot_cb,
-                             kd->corot_G + (size_t)e * 3 * nn, nn, w);
+    return fcm__corot_kernel(kd, kd->corot_K + (size_t)kd->corot_slot[e] * kd->corot_cb,
+                             kd->corot_G + (size_t)kd->corot_slot[e] * 3 * nn, nn, w);
   cell_rule r = get_cell_rule(s, ps->tab, ps->kind, e, w);
   return fcm__cell_kernel(kd, &r, nn, w);
 }

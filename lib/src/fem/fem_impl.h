@@ -497,17 +497,17 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
 fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
                                        const fcm_assembly_workspace *old, const fcm_index *same);
 
-/* As fcm__assembly_corot_inherit(), on old's storage where it holds ws's store (its room, a
- * quarter above its size, fcm__large_take()) and the kept elements keep their order (same[e]
- * increasing and <= e): their matrices are moved within it, not copied into new pages; old is
- * left without a store (ws has taken it: old's workspace can only be destroyed). Else as
- * fcm__assembly_corot_inherit(), old untouched. (corot_store.c) */
+/* As fcm__assembly_corot_inherit(), on old's storage where its free slots hold ws's new
+ * elements (the store has a quarter more slots than its first elements): each kept element
+ * keeps its slot (its matrix is neither moved nor copied), the others take the free slots;
+ * old is left without a store (ws has taken it: old's workspace can only be destroyed). Else
+ * as fcm__assembly_corot_inherit(), old untouched. (corot_store.c) */
 fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_workspace *old,
                                     const fcm_index *same);
 
 /* The store ws took from old (fcm__assembly_corot_take()) back to old after a failed cut, none
- * of its matrices counted as built (their places moved): old builds them again at its next
- * use, the same bits. Nothing taken: nothing done. (corot_store.c) */
+ * of its matrices counted as built (their slots may hold others'): old builds them again at its
+ * next use, the same bits. Nothing taken: nothing done. (corot_store.c) */
 void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_workspace *old);
 
 /* Element stiffness matrices of the corotated linear model that the hyperelastic assemblies
