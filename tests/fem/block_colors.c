@@ -7,10 +7,13 @@
  * - a local space of half the cells of the octree (the blocks over the local cells only);
  * and a cut space patched from the one before (no constrained copies) takes the blocks and
  * their colours (blocks_kept, the same block_cells, block_color_ptr and block_list) while a
- * space built anew on the same rules has the same arrays. Usage: fem_block_colors */
+ * space built anew on the same rules has the same arrays; on a larger box the cut space takes
+ * the rows of 95 % or more of the copies away from the cut (their elements keep their places
+ * in the visit). Usage: fem_block_colors */
 #include "fem/fem_impl.h"
 #include "test.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -97,6 +100,78 @@ static void octree(void)
   fcm_geometry_destroy(&ball);
 }
 
+/* The share of the copies away from the cut whose rows the cut space takes from the space
+ * before it (cut_row_from): a copy is away when no element using it lies in a cell touching a
+ * node of a cell the cut reached (a cell with other elements, or an element integrated
+ * otherwise). *num_away: their number. */
+static double away_share(const fcm_space *s0, const fcm_space *s1, fcm_index *num_away)
+{
+  const fcm_index *cells = fcm_mesh_cells(s1->mesh), ne = s1->num_elems, ncopy = s1->num_dofs / 3;
+  const int nn = s1->nn;
+  fcm_index *same = malloc(sizeof *same * (size_t)(ne + 1)), away = 0, taken = 0;
+  unsigned char *near = calloc((size_t)fcm_mesh_num_nodes(s1->mesh) + 1, 1);
+  unsigned char *close = calloc((size_t)ncopy + 1, 1);
+  TEST_OK(ctx, fcm__space_cut_same_elements(s0, s1, same, NULL));
+  for (fcm_index c = 0; c < s1->num_cells; c++) {
+    int reached =
+        s1->cell_elem[c + 1] - s1->cell_elem[c] != s0->cell_elem[c + 1] - s0->cell_elem[c];
+    for (fcm_index e = s1->cell_elem[c]; e < s1->cell_elem[c + 1]; e++)
+      reached |= same[e] < 0;
+    for (int a = 0; a < nn && reached; a++)
+      near[cells[c * nn + a]] = 1;
+  }
+  for (fcm_index e = 0; e < ne; e++) {
+    int touch = 0;
+    for (int a = 0; a < nn; a++)
+      touch |= near[cells[s1->elem_cell[e] * nn + a]];
+    for (int a = 0; a < nn && touch; a++)
+      close[s1->elem_dof[e * nn + a] / 3] = 1;
+  }
+  for (fcm_index k = 0; k < ncopy; k++)
+    if (!close[k]) away++, taken += s1->cut_row_from && s1->cut_row_from[k] >= 0;
+  free(same), free(near), free(close);
+  *num_away = away;
+  return away ? (double)taken / (double)away : 0.0;
+}
+
+/* A Hex8 box of 8,000 cells (63 blocks) with an embedded box cut by a plane through its
+ * middle: the elements away from the cut keep their places in the assembly's visit, so the
+ * cut space takes the rows of every copy away from the cut. */
+static void away_rows(void)
+{
+  const double lo[3] = {-0.05, -0.05, -0.05}, hi[3] = {1.05, 1.05, 1.05};
+  const double glo[3] = {0, 0, 0}, ghi[3] = {1, 1, 1};
+  const fcm_index nc[3] = {20, 20, 20}, gn[3] = {2, 2, 2};
+  const double p[3] = {0.52, 0.5, 0.5}, n[3] = {1.0, 0.1, 0.05};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *g = NULL;
+  fcm_surface *cut = NULL;
+  fcm_cell_rules *r0 = NULL, *r1 = NULL;
+  fcm_space *s0 = NULL, *s1 = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, nc, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, NULL, &r0));
+  TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, r0, &s0));
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p, n, lo, hi, &cut));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, cut, &r1));
+  if (r1) TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, r1, NULL, s0, &s1));
+  if (s0 && s1) {
+    fcm_index away = 0;
+    const double share = away_share(s0, s1, &away);
+    if (getenv("FCM_TEST_VERBOSE"))
+      printf("rows taken: %.3f of %lld copies away from the cut (%lld copies)\n", share,
+             (long long)away, (long long)(s1->num_dofs / 3));
+    TEST_TRUE(s0->num_blocks > 32 && away > s1->num_dofs / 3 / 4 && share >= 0.95);
+  }
+  fcm_space_destroy(&s1);
+  fcm_space_destroy(&s0);
+  fcm_cell_rules_destroy(&r1);
+  fcm_cell_rules_destroy(&r0);
+  fcm_surface_destroy(&cut);
+  fcm_geometry_destroy(&g);
+  fcm_mesh_destroy(&mesh);
+}
+
 /* An embedded box cut by a plane (constraint ratio `ratio`); returns 1 when the cut space had
  * constrained copies. */
 static int cut_box(fcm_element_type type, double ratio)
@@ -159,6 +234,7 @@ int main(void)
   TEST_TRUE(cut_box(FCM_ELEMENT_TET4, 0.2) == 1); /* constrained copies */
   TEST_TRUE(cut_box(FCM_ELEMENT_TET4, fcm_space_options_default().constrain_ratio) == 0);
   TEST_TRUE(cut_box(FCM_ELEMENT_HEX8, fcm_space_options_default().constrain_ratio) == 0);
+  away_rows();
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

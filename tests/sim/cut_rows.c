@@ -72,10 +72,10 @@ static void compare_fresh(const fcm_integrator *old, const fcm_integrator *c, co
   TEST_TRUE(same_bits(c->loads[0].f, f->loads[0].f, n));
   TEST_TRUE(same_bits(c->Ma, f->Ma, n));
   TEST_TRUE(same_bits(c->u, f->u, n) && same_bits(c->v, f->v, n));
-  /* the patch ran: some copies' rows taken, the cut's neighbourhood summed again; the blocks
-   * of assembly do not shift with a cut, so the rows away from it keep their terms' order and
-   * nearly all are taken: of the copies whose elements all keep their blocks and whose
-   * graph rows the space took over (the cut's neighbourhood left out), 95 % at least */
+  /* the patch ran: some copies' rows taken, the cut's neighbourhood summed again; of the
+   * copies whose rows the space takes over (cut_row_from) and whose elements all keep their
+   * blocks, 95 % at least are taken (fem_block_colors: the space takes every row away from
+   * the cut) */
   const fcm_index ncopy = n / 3, ne = c->space->num_elems;
   fcm_index *same = malloc(sizeof *same * (size_t)(ne + 1)), away = 0;
   unsigned char *near = calloc((size_t)ncopy + 1, 1);
