@@ -13,12 +13,15 @@
 #include <omp.h>
 #include <string.h>
 
-/* The blocks: each element once, the blocks of a colour pairwise without a shared copy. */
+/* The blocks: each element once, in its cell's block, the blocks of a colour pairwise without
+ * a shared copy; the blocks are runs of FCM__SPACE_BLOCK cells. */
 static void check_blocks(const fcm_space *s)
 {
-  const fcm_index ne = s->num_local_elems, nb = (ne + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
+  const fcm_index ne = s->num_local_elems, nb = s->num_blocks;
+  TEST_TRUE(nb == (s->num_block_cells + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK);
   TEST_TRUE(s->num_block_colors >= 1 && s->block_color_ptr[s->num_block_colors] == nb);
   TEST_TRUE(nb >= 8); /* the box is large enough to have blocks to run in parallel */
+  TEST_TRUE(s->block_ptr[0] == 0 && s->block_ptr[nb] == ne);
   unsigned char *seen = calloc((size_t)nb, 1);
   fcm_index *owner = malloc(sizeof *owner * (size_t)(s->num_dofs / 3));
   for (int c = 0; c < s->num_block_colors; c++) {
@@ -28,12 +31,19 @@ static void check_blocks(const fcm_space *s)
       const fcm_index b = s->block_list[i];
       TEST_TRUE(b >= 0 && b < nb && !seen[b]);
       seen[b] = 1;
-      for (fcm_index j = b * FCM__SPACE_BLOCK; j < FCM_MIN(ne, (b + 1) * FCM__SPACE_BLOCK); j++)
+      for (fcm_index j = s->block_ptr[b]; j < s->block_ptr[b + 1]; j++) {
+        const fcm_index e = s->local_elem ? s->local_elem[s->block_elems[j]] : s->block_elems[j];
+        int in_block = 0; /* the element's cell is one of the block's */
+        for (fcm_index q = b * FCM__SPACE_BLOCK;
+             q < FCM_MIN(s->num_block_cells, (b + 1) * FCM__SPACE_BLOCK); q++)
+          in_block |= s->block_cells[q] == s->elem_cell[e];
+        TEST_TRUE(in_block);
         for (int a = 0; a < s->nn; a++) {
-          const fcm_index k = s->elem_dof[s->block_elems[j] * s->nn + a] / 3;
+          const fcm_index k = s->elem_dof[e * s->nn + a] / 3;
           TEST_TRUE(owner[k] < 0 || owner[k] == b);
           owner[k] = b;
         }
+      }
     }
   }
   for (fcm_index b = 0; b < nb; b++)

@@ -4,8 +4,9 @@
  * into cells already cut), each cut space patched from the patched one before it; once with the
  * default constraint ratio and once with a large one that constrains tiny copies (Koschier). The
  * patch must take graph rows from the space before the cut (a tenth at least: not rebuild them),
- * and a space before the cut with one stale offset, or two entries of its block order swapped,
- * gives a different space (the offsets and the order are taken, and the comparison sees them).
+ * and a space before the cut with one stale offset, two cells of its block order or two blocks
+ * of different colours swapped, gives a different space (the offsets, the blocks and their
+ * colours are taken where neither space has constrained copies, and the comparison sees them).
  * Usage: fem_cut_space <element> */
 #include "fem/fem_impl.h"
 #include "test.h"
@@ -16,6 +17,7 @@
 #include <string.h>
 
 static fcm_ctx *ctx;
+static int block_colors_swapped; /* patches made from a space with two block colours swapped */
 
 /* 1 when the n items of size sz at a and b hold the same bits. */
 static int same(const void *a, const void *b, size_t n, size_t sz)
@@ -28,12 +30,13 @@ static int same_space(const fcm_space *a, const fcm_space *b)
 {
   const size_t I = sizeof(fcm_index), nn = (size_t)a->nn;
   const size_t nc = (size_t)a->num_cells, np = (size_t)a->num_nodes, ne = (size_t)a->num_elems;
-  const size_t ncopy = (size_t)a->num_dofs / 3, nb = (ne + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
+  const size_t ncopy = (size_t)a->num_dofs / 3, nb = (size_t)a->num_blocks;
   if (a->nn != b->nn || a->num_dofs != b->num_dofs || a->num_elems != b->num_elems ||
       a->num_constrained != b->num_constrained || a->num_colors != b->num_colors ||
       a->num_block_colors != b->num_block_colors || a->max_cut_points != b->max_cut_points ||
       !a->elem_con != !b->elem_con || a->num_local_copies != b->num_local_copies ||
-      a->num_local_elems != b->num_local_elems)
+      a->num_local_elems != b->num_local_elems || a->num_blocks != b->num_blocks ||
+      a->num_block_cells != b->num_block_cells)
     return 0;
   int ok = same(a->active, b->active, nc, 1) && same(a->node_dof, b->node_dof, np, I) &&
            same(a->node_ncopy, b->node_ncopy, np, I) &&
@@ -48,7 +51,9 @@ static int same_space(const fcm_space *a, const fcm_space *b)
   ok = ok && same(a->color_ptr, b->color_ptr, (size_t)a->num_colors + 1, I) &&
        same(a->color_elems, b->color_elems, ne, I);
   ok = ok && same(a->block_color_ptr, b->block_color_ptr, (size_t)a->num_block_colors + 1, I) &&
-       same(a->block_list, b->block_list, nb, I) && same(a->block_elems, b->block_elems, ne, I);
+       same(a->block_list, b->block_list, nb, I) && same(a->block_elems, b->block_elems, ne, I) &&
+       same(a->block_ptr, b->block_ptr, nb + 1, I) &&
+       same(a->block_cells, b->block_cells, (size_t)a->num_block_cells, I);
   return ok && !a->local_elem && !b->local_elem && !a->elem_lcopy && !b->elem_lcopy;
 }
 
@@ -110,18 +115,31 @@ static fcm_index run(const fcm_mesh *mesh, const fcm_geometry *g, double ratio)
         off[e0 * nn2 + 1] = keep;
         fcm_space_destroy(&stale);
       }
-      /* the block order is taken from the space before the cut (its active cells are the
-       * same): two of its entries swapped show in the patch */
-      fcm_index *order = space[k - 1]->block_elems;
-      const fcm_index b0 = order[0], b1 = order[ne - 1];
-      TEST_TRUE(space[k - 1]->elem_cell[b0] != space[k - 1]->elem_cell[b1]);
-      order[0] = b1, order[ne - 1] = b0;
+      /* the blocks and their colours are taken from the space before the cut where neither
+       * space has constrained copies (the active cells are the same): two of its block cells
+       * swapped, or two blocks of different colours, show in the patch */
+      const int keep = !space[k - 1]->elem_con && !space[k]->elem_con;
+      TEST_TRUE(space[k]->blocks_kept == keep && !fresh->blocks_kept);
       fcm_space *swapped = NULL;
-      TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &swapped));
-      TEST_TRUE(swapped && !same(swapped->block_elems, fresh->block_elems, (size_t)fresh->num_elems,
-                                 sizeof(fcm_index)));
-      order[0] = b0, order[ne - 1] = b1;
-      fcm_space_destroy(&swapped);
+      if (keep) {
+        fcm_index *order = space[k - 1]->block_cells, *bl = space[k - 1]->block_list;
+        const fcm_index nbc = space[k - 1]->num_block_cells, c0 = order[0], c1 = order[nbc - 1];
+        order[0] = c1, order[nbc - 1] = c0;
+        TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &swapped));
+        TEST_TRUE(swapped && !same(swapped->block_elems, fresh->block_elems,
+                                   (size_t)fresh->num_elems, sizeof(fcm_index)));
+        order[0] = c0, order[nbc - 1] = c1;
+        fcm_space_destroy(&swapped);
+        if (space[k - 1]->num_block_colors > 1) { /* the tets' boxes have several blocks */
+          const fcm_index i1 = space[k - 1]->block_color_ptr[1], b0 = bl[0], b1 = bl[i1];
+          bl[0] = b1, bl[i1] = b0;
+          TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[k - 1], &swapped));
+          TEST_TRUE(swapped && !same_space(swapped, fresh));
+          bl[0] = b0, bl[i1] = b1;
+          fcm_space_destroy(&swapped);
+          block_colors_swapped++;
+        }
+      }
       /* the colours of the elements away from the cut are taken too: the first elements of
        * colours 0 and 1 (at the corner at the origin) swapped show in the patch; the third cut
        * runs along the body within reach of every element */
@@ -231,7 +249,9 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, nc, &mesh));
   TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
   run(mesh, g, fcm_space_options_default().constrain_ratio);
-  TEST_TRUE(run(mesh, g, 0.2) > 0);  /* tiny copies constrained */
+  TEST_TRUE(run(mesh, g, 0.2) > 0); /* tiny copies constrained */
+  /* the tets' active cells make several blocks (the hexahedra's fit in one) */
+  if (fcm_element_get_info(type)->num_corners == 4) TEST_TRUE(block_colors_swapped > 0);
   TEST_TRUE(run_take(mesh, g) >= 2); /* the third cut adds more than the room */
   fcm_geometry_destroy(&g);
   fcm_mesh_destroy(&mesh);

@@ -73,6 +73,9 @@ endforeach()
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(fem_cut_space_${el} tests/fem/cut_space.c ARGS ${el})
 endforeach()
+# Assembly's blocks of cells coloured by shared mesh nodes: no two blocks of a colour share a
+# copy on an octree, a local space and with constrained copies; a cut keeps blocks and colours.
+fcm_add_test(fem_block_colors tests/fem/block_colors.c)
 # Octree backgrounds: continuity through the hanging-node constraints and patch tests across
 # hanging nodes (affine fields; quadratic ones for Hex20).
 foreach(el hex8 hex20)

@@ -417,8 +417,8 @@ static cell_result volume_cell(const fcm_space *s, const pass *ps, fcm_index e, 
       memcpy(w->ue + 3 * a, kd->u + ed[a], 3 * sizeof(double));
   }
   if (kd->kind == KERNEL_COROT_LINEAR)
-    return fcm__corot_kernel(kd, kd->corot_K + (size_t)e * kd->corot_cb,
-                             kd->corot_G + (size_t)e * 3 * nn, nn, w);
+    return fcm__corot_kernel(kd, kd->corot_K + (size_t)kd->corot_slot[e] * kd->corot_cb,
+                             kd->corot_G + (size_t)kd->corot_slot[e] * 3 * nn, nn, w);
   cell_rule r = get_cell_rule(s, ps->tab, ps->kind, e, w);
   return fcm__cell_kernel(kd, &r, nn, w);
 }
@@ -527,7 +527,6 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
   fcm_index bad_cell = -1;
   double bad_det = 1.0;
   int bad_numeric = 0;
-  const fcm_index ne = s->num_local_elems;
   const int ahead = scatter_ahead(s, ps->vals);
   for (int color = 0; color < s->num_block_colors; color++) {
     const fcm_index b0 = s->block_color_ptr[color], b1 = s->block_color_ptr[color + 1];
@@ -536,8 +535,8 @@ static fcm_status run_pass(fcm_assembly_workspace *ws, const pass *ps)
       scratch *w = ws->sc + omp_get_thread_num();
 #pragma omp for schedule(dynamic, 1)
       for (fcm_index k = b0; k < b1; k++) {
-        const fcm_index first = s->block_list[k] * FCM__SPACE_BLOCK;
-        const fcm_index last = FCM_MIN(ne, first + FCM__SPACE_BLOCK);
+        const fcm_index first = s->block_ptr[s->block_list[k]];
+        const fcm_index last = s->block_ptr[s->block_list[k] + 1];
         for (fcm_index j = first; j < last; j++) {
           const fcm_index le = s->block_elems[j];
           const fcm_index next = ahead && j + ahead < last ? s->block_elems[j + ahead] : -1;

@@ -17,12 +17,16 @@ typedef struct tabulation {
  * cb doubles per element) and mean gradients, built on first use for the elements whose have[e] is
  * 0 and kept across assemblies (and across a cut, for the elements it leaves: corot_store.c). */
 typedef struct corot_store {
-  double *K;           /* num_elems x cb, or NULL */
+  double *K;           /* cap x cb, or NULL: element e's at slot[e] */
   unsigned char *have; /* num_elems: K of element e is built */
   size_t cb;
   double lambda, mu; /* the Lame parameters K was built with */
-  double *G;         /* num_elems x 3 nn: the elements' mean shape function gradients */
+  double *G;         /* cap x 3 nn: the elements' mean shape function gradients, by slot */
   fcm_index built;   /* element matrices built since the workspace's creation */
+  /* num_elems: each element's slot in K and G (distinct, below cap). A cut's store keeps each
+   * kept element's slot and gives the others free ones, so nothing moves */
+  fcm_index *slot;
+  fcm_index cap;
 } corot_store;
 
 /* Everything an assembly writes besides its outputs. The standard rule of each

@@ -14,27 +14,34 @@ void fcm__assembly_corot_free(fcm_assembly_workspace *ws)
   fcm__free_large(ws->ctx, ws->corot.K);
   fcm__free(ws->ctx, ws->corot.have);
   fcm__free_large(ws->ctx, ws->corot.G);
+  fcm__free(ws->ctx, ws->corot.slot);
   ws->corot.G = NULL;
   ws->corot.K = NULL;
   ws->corot.have = NULL;
+  ws->corot.slot = NULL;
+  ws->corot.cap = 0;
 }
 
-/* Allocate the store (nothing built): large arrays, with room for a cut's successor to take
- * them (fcm__assembly_corot_take()). */
+/* A new store, each element at its own slot, with a quarter more slots for the elements of
+ * later cuts (fcm__assembly_corot_take(); address space only for a large store). */
 static fcm_status store_alloc(fcm_assembly_workspace *ws)
 {
   fcm_status st = FCM_OK;
   const fcm_space *s = ws->space;
   corot_store *c = &ws->corot;
+  const fcm_index ne = s->num_elems;
   c->cb = 9 * (size_t)s->nn * (size_t)(s->nn + 1) / 2;
-  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)s->num_elems * c->cb + 1, c->K);
-  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)s->num_elems * 3 * s->nn + 1, c->G);
-  FCM_ALLOC(ws->ctx, (size_t)s->num_elems + 1, c->have);
+  c->cap = ne + ne / 4 + 1;
+  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)c->cap * c->cb, c->K);
+  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)c->cap * 3 * s->nn, c->G);
+  FCM_ALLOC(ws->ctx, (size_t)ne + 1, c->have);
+  FCM_ALLOC_RAW(ws->ctx, (size_t)ne + 1, c->slot);
+  for (fcm_index e = 0; e < ne; e++)
+    c->slot[e] = e;
 cleanup:
   return st;
 }
 
-/* Build the missing element matrices in parallel (each element writes its own slot). */
 static fcm_status store_build(fcm_assembly_workspace *ws, const tabulation *t)
 {
   fcm_status st = FCM_OK;
@@ -59,8 +66,8 @@ static fcm_status store_build(fcm_assembly_workspace *ws, const tabulation *t)
         if (bad < 0 || e < bad) bad = e, bad_det = res.bad_det;
         continue;
       }
-      memcpy(c->K + (size_t)e * c->cb, w->Ke, sizeof(double) * c->cb);
-      fcm__assembly_mean_gradients(s, t, e, w, c->G + (size_t)e * 3 * s->nn);
+      memcpy(c->K + (size_t)c->slot[e] * c->cb, w->Ke, sizeof(double) * c->cb);
+      fcm__assembly_mean_gradients(s, t, e, w, c->G + (size_t)c->slot[e] * 3 * s->nn);
       c->have[e] = 1;
       built++;
     }
@@ -96,6 +103,7 @@ fcm_status fcm__assembly_corot_prepare(fcm_assembly_workspace *ws, const fcm_mat
   kd->corot_K = c->K;
   kd->corot_cb = c->cb;
   kd->corot_G = c->G;
+  kd->corot_slot = c->slot;
 cleanup:
   return st;
 }
@@ -117,11 +125,36 @@ fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
     const fcm_index f = same[e];
     c->have[e] = f >= 0 && o->have[f];
     if (!c->have[e]) continue;
-    memcpy(c->K + (size_t)e * c->cb, o->K + (size_t)f * o->cb, sizeof(double) * c->cb);
-    memcpy(c->G + (size_t)e * g, o->G + (size_t)f * g, sizeof(double) * g);
+    memcpy(c->K + (size_t)c->slot[e] * c->cb, o->K + (size_t)o->slot[f] * o->cb,
+           sizeof(double) * c->cb);
+    memcpy(c->G + (size_t)c->slot[e] * g, o->G + (size_t)o->slot[f] * g, sizeof(double) * g);
   }
 cleanup:
   return st;
+}
+
+/* The slots of ws's elements in old's store: a kept element (same[e] >= 0, built in old) keeps
+ * its parent's slot, the others take the free slots in ascending order. 0 (nothing written)
+ * when the free slots do not suffice. used: old's cap flags, zero. */
+static int take_slots(const corot_store *o, fcm_index ne, const fcm_index *same, corot_store *c,
+                      unsigned char *used)
+{
+  fcm_index kept = 0, next = 0;
+  for (fcm_index e = 0; e < ne; e++)
+    if (same[e] >= 0 && o->have[same[e]]) used[o->slot[same[e]]] = 1, kept++;
+  if (ne > o->cap) return 0; /* ne - kept new slots among the cap - kept free ones */
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index f = same[e];
+    c->have[e] = f >= 0 && o->have[f];
+    if (c->have[e]) {
+      c->slot[e] = o->slot[f];
+      continue;
+    }
+    while (used[next])
+      next++;
+    c->slot[e] = next++;
+  }
+  return 1;
 }
 
 fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_workspace *old,
@@ -129,37 +162,27 @@ fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_wor
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = ws ? ws->ctx : NULL;
+  unsigned char *used = NULL;
   FCM_CHECK(ws && old && same, ctx, FCM_ERR_ARG, "corotated_linear: NULL workspace or map");
   corot_store *o = &old->corot, *c = &ws->corot;
   const fcm_index ne = ws->space->num_elems;
-  const size_t g = 3 * (size_t)ws->space->nn;
-  int in_order = o->K && !c->K && ws->space->nn == old->space->nn;
-  for (fcm_index e = 0, last = -1; in_order && e < ne; e++) {
-    const fcm_index f = same[e];
-    if (f < 0 || !o->have[f]) continue;
-    in_order = f <= e && f > last; /* moved up only, so that a pass downwards moves each once */
-    last = f;
-  }
-  void *kf = in_order ? o->K : NULL, *gf = o->G;
-  double *K = fcm__large_take(&kf, (size_t)ne * o->cb + 1, sizeof *K), *G = NULL;
-  if (!K) return fcm__assembly_corot_inherit(ws, old, same); /* nothing taken */
+  if (!o->K || !o->G || c->K || ws->space->nn != old->space->nn)
+    return fcm__assembly_corot_inherit(ws, old, same);
+  FCM_ALLOC(ctx, (size_t)o->cap + 1, used);
   FCM_ALLOC(ctx, (size_t)ne + 1, c->have);
-  G = fcm__large_take(&gf, (size_t)ne * g + 1, sizeof *G); /* else copied into a new one */
-  if (!G) FCM__ALLOC_WITH(fcm__calloc_large, ctx, (size_t)ne * g + 1, G);
-  const double *Gf = gf ? o->G : G; /* where the kept mean gradients are */
-  c->K = K, c->G = G, o->K = NULL;
-  if (!gf) o->G = NULL;
-  c->cb = o->cb;
+  FCM_ALLOC_RAW(ctx, (size_t)ne + 1, c->slot);
+  if (!take_slots(o, ne, same, c, used)) { /* full: copied into a new store */
+    FCM_FREE(ctx, c->have);
+    FCM_FREE(ctx, c->slot);
+    FCM_TRY(ctx, fcm__assembly_corot_inherit(ws, old, same));
+    goto cleanup;
+  }
+  c->K = o->K, c->G = o->G, c->cap = o->cap, c->cb = o->cb;
+  o->K = NULL, o->G = NULL;
   c->lambda = o->lambda;
   c->mu = o->mu;
-  for (fcm_index e = ne - 1; e >= 0; e--) {
-    const fcm_index f = same[e];
-    c->have[e] = f >= 0 && o->have[f];
-    if (!c->have[e]) continue;
-    if (f != e) memcpy(K + (size_t)e * c->cb, K + (size_t)f * c->cb, sizeof(double) * c->cb);
-    if (f != e || Gf != G) memcpy(G + (size_t)e * g, Gf + (size_t)f * g, sizeof(double) * g);
-  }
 cleanup:
+  fcm__free(ctx, used);
   return st;
 }
 
@@ -167,9 +190,8 @@ void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_work
 {
   corot_store *c = &ws->corot, *o = &old->corot;
   if (!c->K || o->K || !o->have) return; /* old's store is its own (nothing taken) */
-  o->K = c->K, c->K = NULL;
-  if (!o->G) o->G = c->G, c->G = NULL; /* else old's mean gradients were copied, not moved */
-  memset(o->have, 0, (size_t)old->space->num_elems);
+  o->K = c->K, o->G = c->G, c->K = NULL, c->G = NULL;
+  memset(o->have, 0, (size_t)old->space->num_elems); /* its slots' matrices may be others' */
 }
 
 fcm_index fcm__assembly_corot_built(const fcm_assembly_workspace *ws)

@@ -21,7 +21,7 @@ typedef struct fcm__space_mass_cache {
   double *blocks;
 } fcm__space_mass_cache;
 
-/* Local elements per block of assembly's visiting order (block_color_ptr, block_list). */
+/* Cells per block of assembly's visiting order (block_ptr, block_color_ptr, block_list). */
 enum { FCM__SPACE_BLOCK = 128 };
 
 struct fcm_space {
@@ -93,13 +93,18 @@ struct fcm_space {
   int num_colors;
   fcm_index *color_ptr;
   fcm_index *color_elems;
-  /* Assembly's visiting order: block_elems lists the local element positions in the Morton
-   * order of their cells' centres; block b is its entries [b B, min((b + 1) B,
-   * num_local_elems)) (B = FCM__SPACE_BLOCK), a compact cluster of cells. The blocks are
-   * coloured so that no two of a colour share a copy: block_color_ptr[c]..block_color_ptr[c+1]
-   * index block_list, the blocks of colour c ascending. One thread assembles a whole block, so
-   * neighbouring cells follow each other and their matrix rows are still in cache
-   * (assemble.c). */
+  /* Assembly's visiting order: block_cells lists the cells with local elements (a full
+   * space: the active cells) in the Morton order of their centres; block b holds the cells
+   * [b B, min((b + 1) B, num_block_cells)) of it (B = FCM__SPACE_BLOCK), a compact cluster,
+   * and their local elements block_elems[block_ptr[b] .. block_ptr[b + 1]) (cell by cell, each
+   * cell's elements ascending). The blocks are coloured so that no two of a colour share a mesh
+   * node of their cells (or the node of a copy a constrained element uses in another node's
+   * place): block_color_ptr[c]..block_color_ptr[c+1] index block_list, the blocks of colour c
+   * ascending. One thread assembles a whole block, so neighbouring cells follow each other and
+   * their matrix rows are still in cache (assemble.c). The blocks and their colours depend on
+   * the active cells alone (and the constrained elements' copies): a cut, which adds elements
+   * to the cells it reaches, changes neither, so every element away from the cut keeps its
+   * place in the visit. */
   int num_block_colors;
   /* Copy graph rows fcm__space_build_topology_cut() took from the space before the cut (0: the
    * topology was built anew) */
@@ -107,6 +112,12 @@ struct fcm_space {
   fcm_index *block_color_ptr;
   fcm_index *block_list;
   fcm_index *block_elems; /* num_local_elems */
+  fcm_index num_blocks, num_block_cells;
+  fcm_index *block_ptr;   /* num_blocks + 1 */
+  fcm_index *block_cells; /* num_block_cells */
+  /* 1 when fcm__space_build_topology_cut() took block_cells and the block colours from the
+   * space before the cut */
+  int blocks_kept;
   /* Embedded case: per-cell rules of cut cells (borrowed) and the most points any cut
    * cell has in either rule. Nothing here changes after creation: assembly scratch lives
    * in fcm_assembly_workspace (assemble.c). */
@@ -403,6 +414,14 @@ fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_ind
  * (topology.c) */
 fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned char *cell_mask);
 
+/* Assembly's blocks of s (block_cells, block_ptr, block_elems) and their colours, the local
+ * elements (and, for a local space, local_elem and cell_local) made; with `from` (a full space
+ * before the cut of the full space s, NULL otherwise) the cells' order and the colours are taken
+ * from it where both have the same active cells and neither constrained copies: the same
+ * arrays as built anew. @return FCM_OK, FCM_ERR_ALLOC, FCM_ERR_UNSUPPORTED (colours),
+ * FCM_ERR_INTERNAL. (visit.c) */
+fcm_status fcm__space_build_blocks(fcm_space *s, const fcm_space *from);
+
 /* fcm__space_build_topology(s, 0, NULL) for a cut space s (full) from `from`, the full space
  * before the cut (s's rules made from from's by fcm_cell_rules_create_cut()): the graph rows
  * of the copies the cut left as they were (same elements, each the only child of its parent)
@@ -478,17 +497,17 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
 fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
                                        const fcm_assembly_workspace *old, const fcm_index *same);
 
-/* As fcm__assembly_corot_inherit(), on old's storage where it holds ws's store (its room, a
- * quarter above its size, fcm__large_take()) and the kept elements keep their order (same[e]
- * increasing and <= e): their matrices are moved within it, not copied into new pages; old is
- * left without a store (ws has taken it: old's workspace can only be destroyed). Else as
- * fcm__assembly_corot_inherit(), old untouched. (corot_store.c) */
+/* As fcm__assembly_corot_inherit(), on old's storage where its free slots hold ws's new
+ * elements (the store has a quarter more slots than its first elements): each kept element
+ * keeps its slot (its matrix is neither moved nor copied), the others take the free slots;
+ * old is left without a store (ws has taken it: old's workspace can only be destroyed). Else
+ * as fcm__assembly_corot_inherit(), old untouched. (corot_store.c) */
 fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_workspace *old,
                                     const fcm_index *same);
 
 /* The store ws took from old (fcm__assembly_corot_take()) back to old after a failed cut, none
- * of its matrices counted as built (their places moved): old builds them again at its next
- * use, the same bits. Nothing taken: nothing done. (corot_store.c) */
+ * of its matrices counted as built (their slots may hold others'): old builds them again at its
+ * next use, the same bits. Nothing taken: nothing done. (corot_store.c) */
 void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_workspace *old);
 
 /* Element stiffness matrices of the corotated linear model that the hyperelastic assemblies

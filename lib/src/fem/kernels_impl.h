@@ -62,10 +62,12 @@ typedef struct kernel_data {
   fcm_fictitious_model fictitious; /* model at fictitious points (hyperelastic) */
   fcm_material_params mat_psd;     /* *mat with project_psd = 1 */
   /* KERNEL_COROT_LINEAR: the elements' linear stiffness matrices (upper node blocks, cb
-   * doubles each, by element id) and mean shape function gradients (3 nn each) */
+   * doubles each) and mean shape function gradients (3 nn each), element e's at its slot
+   * corot_slot[e] of the store */
   const double *corot_K;
   size_t corot_cb;
   const double *corot_G;
+  const fcm_index *corot_slot;
 } kernel_data;
 
 /* Per-thread scratch of a kernel; ld = fcm__kernel_ld(nn) (the padded row length of the

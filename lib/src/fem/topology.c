@@ -1,6 +1,6 @@
 /* The topology of a space built once after its numbering: the copies' incidence, the copy
  * graph, the scalar CSR pattern with per-element scatter offsets, the element colouring and
- * assembly's colouring of element blocks; of every element or of the local cells only. */
+ * assembly's blocks (visit.c); of every element or of the local cells only. */
 #include "embed/embed_impl.h"
 #include "fem/fem_impl.h"
 
@@ -248,171 +248,6 @@ cleanup:
   return st;
 }
 
-/* A local element position with the Morton key of its cell's centre. */
-typedef struct morton_elem {
-  uint64_t key;
-  fcm_index le;
-} morton_elem;
-
-static int cmp_morton(const void *a, const void *b)
-{
-  const morton_elem *x = a, *y = b;
-  if (x->key != y->key) return (x->key > y->key) - (x->key < y->key);
-  return (x->le > y->le) - (x->le < y->le);
-}
-
-/* The 21 low bits of v spread to every third bit. */
-static uint64_t spread3(uint64_t v)
-{
-  v &= 0x1fffff;
-  v = (v | v << 32) & 0x1f00000000ffffULL;
-  v = (v | v << 16) & 0x1f0000ff0000ffULL;
-  v = (v | v << 8) & 0x100f00f00f00f00fULL;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-  v = (v | v << 2) & 0x1249249249249249ULL;
-  return v;
-}
-
-uint64_t fcm__morton_key(const double x[3], const double lo[3], const double hi[3])
-{
-  uint64_t key = 0;
-  for (int d = 0; d < 3; d++) {
-    const double t = hi[d] > lo[d] ? (x[d] - lo[d]) / (hi[d] - lo[d]) : 0.0;
-    key |= spread3((uint64_t)(fmin(fmax(t, 0.0), 1.0) * 2097151.0)) << d;
-  }
-  return key;
-}
-
-/* block_elems: the local element positions in the Morton (Z-curve) order of their cells'
- * centres on a 2^21 grid over the elements' bounding box (ties, the pieces of one cell, by
- * position), so that runs of FCM__SPACE_BLOCK of them are compact clusters of cells. */
-static fcm_status build_block_order(fcm_space *s)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = s->ctx;
-  const fcm_index ne = s->num_local_elems;
-  const int nn = s->nn;
-  morton_elem *m = NULL;
-  double *ctr = NULL, X[3 * FCM_ELEMENT_MAX_NODES], lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL},
-         hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  FCM_ALLOC(ctx, ne + 1, m);
-  FCM_ALLOC(ctx, 3 * ne + 1, ctr);
-  for (fcm_index e = 0; e < ne; e++) {
-    fcm_mesh_cell_coords(s->mesh, s->elem_cell[local_elem(s, e)], X);
-    for (int d = 0; d < 3; d++) {
-      double c = 0.0;
-      for (int a = 0; a < nn; a++)
-        c += X[3 * a + d];
-      ctr[3 * e + d] = c / nn;
-      lo[d] = fmin(lo[d], c / nn), hi[d] = fmax(hi[d], c / nn);
-    }
-  }
-  for (fcm_index e = 0; e < ne; e++)
-    m[e].key = fcm__morton_key(ctr + 3 * e, lo, hi), m[e].le = e;
-  qsort(m, (size_t)ne, sizeof *m, cmp_morton);
-  FCM_ALLOC(ctx, ne + 1, s->block_elems);
-  for (fcm_index e = 0; e < ne; e++)
-    s->block_elems[e] = m[e].le;
-cleanup:
-  fcm__free(ctx, m);
-  fcm__free(ctx, ctr);
-  return st;
-}
-
-/* build_block_order() of a full space s after a cut from the full space `from` whose active cells
- * are s's: the cells' centres and their box are the same, so the Morton keys are, and the
- * elements of a cell (one key, ascending positions) follow each other in both orders; the cut
- * only changes how many elements each cell has. So each run of a cell's elements in from's
- * order becomes the run of its elements in s. *done = 0 (nothing made) when the active cells
- * differ. */
-static fcm_status patch_block_order(fcm_space *s, const fcm_space *from, int *done)
-{
-  fcm_status st = FCM_OK;
-  fcm_index *order = NULL, j = 0;
-  *done = 0;
-  if (from->num_cells != s->num_cells || !from->block_elems || from->local_elem || s->local_elem ||
-      memcmp(from->active, s->active, (size_t)s->num_cells) != 0)
-    return FCM_OK;
-  FCM_ALLOC_RAW(s->ctx, s->num_elems + 1, order);
-  for (fcm_index i = 0; i < from->num_elems; i++) {
-    const fcm_index fe = from->block_elems[i], c = from->elem_cell[fe];
-    if (fe != from->cell_elem[c]) continue; /* the cell's run was written at its first */
-    for (fcm_index e = s->cell_elem[c]; e < s->cell_elem[c + 1] && j < s->num_elems; e++)
-      order[j++] = e;
-  }
-  if (j == s->num_elems) { /* every active cell has elements in both */
-    s->block_elems = order;
-    order = NULL;
-    *done = 1;
-  }
-cleanup:
-  fcm__free(s->ctx, order);
-  return st;
-}
-
-/* Greedy colouring of the blocks of FCM__SPACE_BLOCK consecutive entries of block_elems: a
- * block takes the smallest colour not used by a block with an element sharing a copy with one
- * of its own. */
-static fcm_status build_block_colors(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
-                                     const fcm_index *cinc, const fcm_space *from)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = s->ctx;
-  const fcm_index ne = s->num_local_elems, nb = (ne + FCM__SPACE_BLOCK - 1) / FCM__SPACE_BLOCK;
-  int *color = NULL, ncol = 0;
-  fcm_index *forbid = NULL, *fill = NULL, *block_of = NULL;
-  int patched = 0;
-  if (from) FCM_TRY(ctx, patch_block_order(s, from, &patched));
-  if (!patched) FCM_TRY(ctx, build_block_order(s));
-  FCM_ALLOC(ctx, ne + 1, block_of);
-  for (fcm_index j = 0; j < ne; j++)
-    block_of[s->block_elems[j]] = j / FCM__SPACE_BLOCK;
-  FCM_ALLOC(ctx, nb + 1, color);
-  FCM_ALLOC(ctx, MAX_COLORS, forbid);
-  for (int k = 0; k < MAX_COLORS; k++)
-    forbid[k] = -1;
-  for (fcm_index b = 0; b < nb; b++)
-    color[b] = -1;
-  for (fcm_index b = 0; b < nb; b++) {
-    const fcm_index e1 = FCM_MIN(ne, (b + 1) * FCM__SPACE_BLOCK);
-    for (fcm_index j = b * FCM__SPACE_BLOCK; j < e1; j++) {
-      const fcm_index *ed = s->elem_dof + local_elem(s, s->block_elems[j]) * s->nn;
-      for (int a = 0; a < s->nn; a++) {
-        const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
-        for (fcm_index i = cptr[k]; i < cptr[k + 1]; i++) {
-          const int c = color[block_of[cinc[i]]];
-          if (c >= 0) forbid[c] = b;
-        }
-      }
-    }
-    int k = 0;
-    while (k < MAX_COLORS && forbid[k] == b)
-      k++;
-    FCM_CHECK(k < MAX_COLORS, ctx, FCM_ERR_UNSUPPORTED,
-              "space: element block %lld needs more than %d colours (a node shared by too many "
-              "cells)",
-              (long long)b, MAX_COLORS);
-    color[b] = k;
-    ncol = FCM_MAX(ncol, k + 1);
-  }
-  s->num_block_colors = ncol;
-  FCM_ALLOC(ctx, ncol + 1, s->block_color_ptr);
-  for (fcm_index b = 0; b < nb; b++)
-    s->block_color_ptr[color[b] + 1]++;
-  for (int k = 0; k < ncol; k++)
-    s->block_color_ptr[k + 1] += s->block_color_ptr[k];
-  FCM_ALLOC(ctx, nb + 1, s->block_list);
-  FCM_ALLOC(ctx, ncol + 1, fill);
-  for (fcm_index b = 0; b < nb; b++)
-    s->block_list[s->block_color_ptr[color[b]] + fill[color[b]]++] = b;
-cleanup:
-  fcm__free(ctx, color);
-  fcm__free(ctx, forbid);
-  fcm__free(ctx, fill);
-  fcm__free(ctx, block_of);
-  return st;
-}
-
 void fcm__space_cut_give_back(fcm_space *s)
 {
   fcm_space *from = s ? s->col_from : NULL;
@@ -433,17 +268,20 @@ void fcm__space_free_topology(fcm_space *s)
 {
   fcm_ctx *ctx = s->ctx;
   fcm__space_cut_give_back(s);
-  void *arrays[] = {s->node_ptr,   s->node_adj,    s->row_ptr,     s->col_idx,
-                    s->elem_off,   s->elem_lcopy,  s->color_ptr,   s->color_elems,
-                    s->local_copy, s->local_elem,  s->cell_local,  s->block_color_ptr,
-                    s->block_list, s->block_elems, s->cut_row_from};
+  void *arrays[] = {s->node_ptr,   s->node_adj,    s->row_ptr,      s->col_idx,
+                    s->elem_off,   s->elem_lcopy,  s->color_ptr,    s->color_elems,
+                    s->local_copy, s->local_elem,  s->cell_local,   s->block_color_ptr,
+                    s->block_list, s->block_elems, s->cut_row_from, s->block_ptr,
+                    s->block_cells};
   for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++)
     fcm__free(ctx, arrays[i]);
   s->node_ptr = s->node_adj = s->row_ptr = s->local_copy = s->local_elem = NULL;
   s->color_ptr = s->color_elems = NULL;
   s->col_idx = s->elem_off = s->elem_lcopy = NULL;
   s->cell_local = NULL;
-  s->block_color_ptr = s->block_list = s->block_elems = NULL;
+  s->block_color_ptr = s->block_list = s->block_elems = s->block_ptr = s->block_cells = NULL;
+  s->num_blocks = s->num_block_cells = 0;
+  s->blocks_kept = 0;
   s->cut_row_from = NULL, s->cut_from = NULL;
   s->cut_from_dofs = s->cut_from_elems = 0;
   s->num_colors = s->num_block_colors = 0;
@@ -498,7 +336,7 @@ fcm_status fcm__space_build_topology(fcm_space *s, int local, const unsigned cha
   FCM_TRY(ctx, node_graph(s, g2l, cptr, cinc, NULL, NULL));
   FCM_TRY(ctx, build_pattern(s, g2l));
   FCM_TRY(ctx, build_colors(s, g2l, cptr, cinc));
-  FCM_TRY(ctx, build_block_colors(s, g2l, cptr, cinc, NULL));
+  FCM_TRY(ctx, fcm__space_build_blocks(s, NULL));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);
   fcm__free(ctx, g2l);
@@ -738,9 +576,8 @@ static void visit_ranks(const fcm_space *s, fcm_index *rank)
   fcm_index r = 0;
   for (int c = 0; c < s->num_block_colors; c++)
     for (fcm_index k = s->block_color_ptr[c]; k < s->block_color_ptr[c + 1]; k++) {
-      const fcm_index first = s->block_list[k] * FCM__SPACE_BLOCK;
-      const fcm_index last = FCM_MIN(s->num_local_elems, first + FCM__SPACE_BLOCK);
-      for (fcm_index j = first; j < last; j++)
+      const fcm_index b = s->block_list[k];
+      for (fcm_index j = s->block_ptr[b]; j < s->block_ptr[b + 1]; j++)
         rank[s->block_elems[j]] = r++;
     }
 }
@@ -764,7 +601,10 @@ static int same_visit(const fcm_index *cinc, fcm_index i0, fcm_index i1, const f
 }
 
 /* s->cut_row_from: the copies whose rows are their parents' in the same order (copy_kept 2)
- * and whose elements keep their parents' order of visit. */
+ * and whose elements keep their parents' order of visit. With the blocks and colours taken
+ * from `from` (blocks_kept) every kept element keeps its place in the visit (the same cell, so
+ * the same block and colour and place among the block's cells, and the same place among its
+ * cell's elements), so the elements of a copy_kept copy, all kept, keep their order. */
 static fcm_status mark_cut_rows(fcm_space *s, const fcm_space *from, const fcm_index *cptr,
                                 const fcm_index *cinc, const cut_map *m)
 {
@@ -772,12 +612,20 @@ static fcm_status mark_cut_rows(fcm_space *s, const fcm_space *from, const fcm_i
   fcm_ctx *ctx = s->ctx;
   const fcm_index ncopy = s->num_dofs / 3;
   fcm_index *rank = NULL, *old_rank = NULL, *buf = NULL, most = 1;
+  FCM_ALLOC_RAW(ctx, (size_t)ncopy + 1, s->cut_row_from);
+  s->cut_from = from;
+  s->cut_from_dofs = from->num_dofs;
+  s->cut_from_elems = from->num_elems;
+  if (s->blocks_kept) {
+    for (fcm_index k = 0; k < ncopy; k++)
+      s->cut_row_from[k] = m->copy_kept[k] == 2 ? m->parent[k] : -1;
+    return FCM_OK;
+  }
   for (fcm_index k = 0; k < ncopy; k++)
     most = FCM_MAX(most, cptr[k + 1] - cptr[k]);
   FCM_ALLOC_RAW(ctx, (size_t)s->num_elems + 1, rank);
   FCM_ALLOC_RAW(ctx, (size_t)from->num_elems + 1, old_rank);
   FCM_ALLOC_RAW(ctx, (size_t)most, buf);
-  FCM_ALLOC_RAW(ctx, (size_t)ncopy + 1, s->cut_row_from);
   visit_ranks(s, rank);
   visit_ranks(from, old_rank);
   for (fcm_index k = 0; k < ncopy; k++)
@@ -785,9 +633,6 @@ static fcm_status mark_cut_rows(fcm_space *s, const fcm_space *from, const fcm_i
         m->copy_kept[k] == 2 && same_visit(cinc, cptr[k], cptr[k + 1], rank, old_rank, m, buf)
             ? m->parent[k]
             : -1;
-  s->cut_from = from;
-  s->cut_from_dofs = from->num_dofs;
-  s->cut_from_elems = from->num_elems;
 cleanup:
   fcm__free(ctx, rank);
   fcm__free(ctx, old_rank);
@@ -822,7 +667,7 @@ fcm_status fcm__space_build_topology_cut(fcm_space *s, const fcm_space *from, fc
   FCM_TRY(ctx, build_pattern_rows(s, give == from ? give : NULL));
   FCM_TRY(ctx, patch_offsets(s, from, &m));
   FCM_TRY(ctx, patch_colors(s, from, cptr, cinc, &m));
-  FCM_TRY(ctx, build_block_colors(s, NULL, cptr, cinc, from));
+  FCM_TRY(ctx, fcm__space_build_blocks(s, from));
   FCM_TRY(ctx, mark_cut_rows(s, from, cptr, cinc, &m));
 cleanup:
   if (st != FCM_OK) fcm__space_free_topology(s);

@@ -499,11 +499,13 @@ static fcm_status setup_storage(fcm_integrator *I)
                      &I->ut,   &I->fint_t, &I->g_t,   &I->w1,     &I->w2, &I->fprev};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_ALLOC(ctx, I->n, *vecs[k]);
+  int taken = 0; /* H's values are written whole (fcm__sim_set_base()) before any read: the
+                   values taken from the old integrator's H need no zeroing */
   if (I->hP)
     FCM_TRY(ctx, fcm__sim_hanging_storage(I, &I->H));
   else
-    FCM_TRY(ctx, fcm__space_matrix_create_rows_from(I->space, I->cut_give ? I->cut_give->H : NULL,
-                                                    &I->H));
+    FCM_TRY(ctx, fcm__space_matrix_create_rows_keep(I->space, I->cut_give ? I->cut_give->H : NULL,
+                                                    &I->H, &taken));
   FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
   /* after a cut: the corotated linear model's element matrices the cut leaves valid (moved
    * within the old integrator's store when it gives its storage) */
