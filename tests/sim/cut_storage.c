@@ -4,12 +4,12 @@
  * scenes), one with the option, are stepped and cut twice (a plane across the box, then a slit
  * from the top face): the one with the option gets its mass and Newton matrices on the old
  * ones' storage (the same addresses; the matrices' values are 8 MiB and more, whose room is a
- * quarter larger than asked) and its corotated element matrices moved within the old store,
- * the other on new storage, and the mass matrix, the gravity load,
- * M a_rep, the state and a further step's displacement and velocity are the same bits. The
- * integrator that gave its storage refuses to step, to be set up and to be cut again, and is
- * destroyed. Before the first cut, the cut fails twice (an allocation in its setup, the last
- * one of the cut): the integrator has its storage back and steps on as the other does. */
+ * quarter larger than asked) and its corotated element matrices in the old store (each kept
+ * element at its slot), the other on new storage (the kept element matrices copied), and the mass
+ * matrix, the gravity load, M a_rep, the state and a further step's displacement and velocity are
+ * the same bits. The integrator that gave its storage refuses to step, to be set up and to be cut
+ * again, and is destroyed. Before the first cut, the cut fails twice (an allocation in its setup,
+ * the last one of the cut): the integrator has its storage back and steps on as the other does. */
 #include "fem/assemble_impl.h"
 #include "la/la_impl.h"
 #include "sim/sim_impl.h"
@@ -116,7 +116,8 @@ static void cut_both(fcm_integrator **a, fcm_integrator **b, const fcm_space *sp
   TEST_TRUE(fcm_csr_values_read(a1->M) == am && fcm_csr_values_read(a1->H) == ah);
   TEST_TRUE(fcm_csr_values_read((*a)->M) == NULL && fcm_csr_values_read((*a)->H) == NULL);
   TEST_TRUE(fcm_csr_values_read((*b)->M) == bm && fcm_csr_values_read(b1->M) != bm);
-  /* the corotated element matrices moved within a's store, copied from b's */
+  /* the corotated element matrices in a's store (each kept element at its slot), copied from
+   * b's */
   TEST_TRUE(a1->aws->corot.K == ak && (*a)->aws->corot.K == NULL);
   TEST_TRUE(b1->aws->corot.K != bk && (*b)->aws->corot.K == bk);
   TEST_TRUE(same_bits(fcm_csr_values_read(a1->M), fcm_csr_values_read(b1->M), nnz));
