@@ -180,3 +180,6 @@ fcm_add_test(sim_cut_threads_hex20 tests/sim/cut_overlap.c ARGS hex20 threads)
 foreach(el tet4 tet10 hex8 hex20)
   fcm_add_test(sim_cut_rows_${el} tests/sim/cut_rows.c ARGS ${el})
 endforeach()
+# The corotated store over five cuts: taken while its slots last, a new store when a cut's
+# elements outnumber them; the same bits as a chain that copies it at every cut.
+fcm_add_test(sim_cut_corot_store tests/sim/cut_corot_store.c)

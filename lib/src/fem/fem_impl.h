@@ -327,6 +327,10 @@ fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give,
  * writes every entry: fcm__space_cut_rows()); else zero (*taken 0). (space.c) */
 fcm_status fcm__space_matrix_create_rows_keep(const fcm_space *s, fcm_csr *give, fcm_csr **A,
                                               int *taken);
+/* fcm__space_matrix_create_rows_from() whose values, when taken from give, are left as give
+ * held them (not zeroed; new values are zero). Contract: the caller writes every entry before
+ * any read (the Newton matrix: fcm__sim_set_base() writes it whole each step). (space.c) */
+fcm_status fcm__space_matrix_create_rows_unzeroed(const fcm_space *s, fcm_csr *give, fcm_csr **A);
 
 /* y (num_dofs) = A x for A of fcm__space_matrix_create_rows() (x: num_dofs); y is zero on the
  * DOFs with no row. A full space: fcm_csr_apply(A, 1, x, 0, y) exactly (same bits). Each row is

@@ -368,6 +368,12 @@ fcm_status fcm__space_matrix_create_rows_from(const fcm_space *s, fcm_csr *give,
   return fcm__space_matrix_create_rows_keep(s, give, A, NULL);
 }
 
+fcm_status fcm__space_matrix_create_rows_unzeroed(const fcm_space *s, fcm_csr *give, fcm_csr **A)
+{
+  int taken = 0; /* either way the caller writes every entry */
+  return fcm__space_matrix_create_rows_keep(s, give, A, &taken);
+}
+
 fcm_status fcm__space_matrix_create_rows_keep(const fcm_space *s, fcm_csr *give, fcm_csr **A,
                                               int *taken)
 {

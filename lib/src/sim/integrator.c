@@ -499,16 +499,17 @@ static fcm_status setup_storage(fcm_integrator *I)
                      &I->ut,   &I->fint_t, &I->g_t,   &I->w1,     &I->w2, &I->fprev};
   for (size_t k = 0; k < sizeof vecs / sizeof vecs[0]; k++)
     FCM_ALLOC(ctx, I->n, *vecs[k]);
-  int taken = 0; /* H's values are written whole (fcm__sim_set_base()) before any read: the
-                   values taken from the old integrator's H need no zeroing */
+  /* H's values are written whole (fcm__sim_set_base()) before any read: the values taken
+   * from the old integrator's H need no zeroing */
   if (I->hP)
     FCM_TRY(ctx, fcm__sim_hanging_storage(I, &I->H));
   else
-    FCM_TRY(ctx, fcm__space_matrix_create_rows_keep(I->space, I->cut_give ? I->cut_give->H : NULL,
-                                                    &I->H, &taken));
+    FCM_TRY(ctx, fcm__space_matrix_create_rows_unzeroed(
+                     I->space, I->cut_give ? I->cut_give->H : NULL, &I->H));
   FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
-  /* after a cut: the corotated linear model's element matrices the cut leaves valid (moved
-   * within the old integrator's store when it gives its storage) */
+  /* after a cut: the corotated linear model's element matrices the cut leaves valid (in the
+   * old integrator's store, each kept element at its slot, when it gives its storage; else
+   * copied) */
   if (I->cut_old && I->cut_same)
     FCM_TRY(ctx, I->cut_give ? fcm__assembly_corot_take(I->aws, I->cut_give->aws, I->cut_same)
                              : fcm__assembly_corot_inherit(I->aws, I->cut_old->aws, I->cut_same));
