@@ -3,7 +3,9 @@
  * bit) while level 0's diagonal follows the new values; the third set-up after the creation
  * computes every level again, and then equals a hierarchy created on those values with the
  * default coarse_interval 1 (the level matrices and a cycle bit for bit); the lagged
- * hierarchy still solves (CG + MG to 1e-9); coarse_interval 0 is refused. */
+ * hierarchy still solves (CG + MG to 1e-9); after a failed set-up the cycle refuses and the
+ * next set-up computes every level; a single level is factored at every set-up;
+ * coarse_interval 0 is refused. */
 #include "mg/levels_impl.h"
 #include "mg_util.h"
 
@@ -84,6 +86,47 @@ int main(void)
     free(y1), free(y2);
   }
   free(d0);
+  /* a failed set-up (a diagonal entry NaN) leaves the levels mixed: the cycle refuses until a
+   * set-up succeeds, and that one (the second since set-up 4, not a third) computes every
+   * level: a fresh hierarchy's bits */
+  if (fresh) {
+    double *v = fcm_csr_values(p.A), keep = v[lag->lev[0].diag[0]];
+    v[lag->lev[0].diag[0]] = NAN;
+    TEST_ERR(ctx, fcm_mg_setup(lag), FCM_ERR_NUMERIC, "diagonal");
+    double *y = calloc((size_t)p.n, sizeof *y), *y2 = calloc((size_t)p.n, sizeof *y2);
+    TEST_ERR(ctx, fcm_mg_cycle(lag, p.b, y), FCM_ERR_ARG, "set the hierarchy up again");
+    v[lag->lev[0].diag[0]] = keep;
+    scale_values(p.A, v0, 0.3);
+    TEST_OK(ctx, fcm_mg_setup(lag));
+    fcm_mg_destroy(&fresh);
+    TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &fresh));
+    TEST_OK(ctx, fcm_mg_operator(lag, p.b, y));
+    TEST_OK(ctx, fcm_mg_operator(fresh, p.b, y2));
+    TEST_TRUE(memcmp(y, y2, sizeof *y * (size_t)p.n) == 0);
+    free(y), free(y2);
+  }
+  /* a single level is the finest: factored at every set-up whatever coarse_interval says */
+  {
+    fcm_mg *one = NULL, *one_fresh = NULL;
+    o.coarse_dofs = 10 * p.n;
+    o.coarse_interval = 2;
+    scale_values(p.A, v0, 0.0);
+    TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &one));
+    if (one) {
+      TEST_TRUE(fcm_mg_num_levels(one) == 1);
+      scale_values(p.A, v0, 0.4);
+      TEST_OK(ctx, fcm_mg_setup(one)); /* set-up 2: not a coarse one */
+      TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &one_fresh));
+      double *y = calloc((size_t)p.n, sizeof *y), *y2 = calloc((size_t)p.n, sizeof *y2);
+      TEST_OK(ctx, fcm_mg_operator(one, p.b, y));
+      if (one_fresh) TEST_OK(ctx, fcm_mg_operator(one_fresh, p.b, y2));
+      TEST_TRUE(memcmp(y, y2, sizeof *y * (size_t)p.n) == 0);
+      free(y), free(y2);
+    }
+    fcm_mg_destroy(&one);
+    fcm_mg_destroy(&one_fresh);
+    o.coarse_dofs = 100;
+  }
   {
     fcm_mg *bad = NULL;
     o.coarse_interval = 0;

@@ -109,7 +109,9 @@ typedef struct fcm_mg_options {
   int coarse_interval;      /**< 1 (default): fcm_mg_setup() computes every level's values;
                                  k > 1: the coarser levels' (Galerkin products, their block
                                  smoothers, the coarsest factorization) at every k-th set-up
-                                 of a hierarchy only (its first included), the finest level's
+                                 of a hierarchy only (its first included: fcm_mg_create()
+                                 with values counts as the first, so with k = 2 the next
+                                 fcm_mg_setup() keeps the coarser levels), the finest level's
                                  diagonal and block smoother at each: the coarse correction
                                  then uses operators of up to k - 1 set-ups before (a
                                  corotated matrix's rotations of a few steps), for the
@@ -178,9 +180,14 @@ typedef struct fcm_mg fcm_mg;
 FCM_API fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
                                  const fcm_mg_options *opts, fcm_mg **mg);
 
-/** New values of the same A (same pattern, same eliminated rows): recompute the Galerkin
- * matrices and the coarsest factorization. @return FCM_OK, FCM_ERR_ARG (NULL, other size, a
- * different set of eliminated rows), the factorization's errors. No allocation but CHOLMOD's. */
+/** New values of the same A (same pattern, same eliminated rows): recompute the finest
+ * level's smoothers and, at the set-ups fcm_mg_options.coarse_interval selects (every one by
+ * default; always when the hierarchy has a single level), the Galerkin matrices, the coarser
+ * smoothers and the coarsest factorization. After a failed set-up the levels may hold old and
+ * new values mixed: fcm_mg_cycle() and fcm_mg_solve() refuse (FCM_ERR_ARG) until a set-up
+ * succeeds, and that one recomputes every level. @return FCM_OK, FCM_ERR_ARG (NULL, other
+ * size, a different set of eliminated rows), FCM_ERR_NUMERIC (a diagonal entry not positive
+ * and finite), the smoothers' and the factorization's errors. No allocation but CHOLMOD's. */
 FCM_API fcm_status fcm_mg_setup(fcm_mg *mg);
 
 /** Destroy; accepts NULL and `*mg == NULL`, sets `*mg = NULL`. */

@@ -26,7 +26,8 @@ typedef struct {
   size_t capacity;
 } large_header;
 
-void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size)
+/* fcm__calloc_large(); zero: fill the n elements with zeros (else left untouched). */
+static void *alloc_large(fcm_ctx *ctx, size_t n, size_t size, int zero)
 {
   if (size && n > SIZE_MAX / size) {
     fcm__error(ctx, FCM_ERR_ALLOC, __FILE__, __LINE__, __func__,
@@ -54,8 +55,18 @@ void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size)
    * Advice only: refused (kernel without transparent huge pages), the array still works. */
   if (align == HUGE_PAGE) (void)madvise(p, capacity - capacity % HUGE_PAGE, MADV_HUGEPAGE);
 #endif
-  memset(p, 0, bytes);
+  if (zero) memset(p, 0, bytes);
   return p;
+}
+
+void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size)
+{
+  return alloc_large(ctx, n, size, 1);
+}
+
+void *fcm__malloc_large(fcm_ctx *ctx, size_t n, size_t size)
+{
+  return alloc_large(ctx, n, size, 0);
 }
 
 void *fcm__large_take(void **from, size_t n, size_t size)

@@ -70,6 +70,10 @@ FCM_COMPONENT_API void fcm__free(fcm_ctx *ctx, void *ptr);
  * Released with fcm__free_large only. */
 void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size);
 
+/* As fcm__calloc_large without the zero fill: for arrays whose entries are written before
+ * they are read; pages never written are never touched (address space only). */
+void *fcm__malloc_large(fcm_ctx *ctx, size_t n, size_t size);
+
 /* As fcm__calloc_large, on the storage of *from (an array of fcm__calloc_large, or NULL) when
  * n elements fill at least half of its room (a large array's room is a quarter more than it
  * was asked for): *from is then set to NULL (its owner gives it up) and the array zero filled

@@ -404,6 +404,19 @@ cleanup:
   return st;
 }
 
+/* Whether cell c, which the new cut does not reach, is copied from the rules extended: it
+ * needs no work outside the region, where its links with every region neighbour are kept, or
+ * where it has no pieces (the links skip such a cell: its face polygons would be read by no cut
+ * until one reaches it and makes them again); *kept_faces: a region cell with the face
+ * polygons the earlier cut kept. */
+static int copied_cell(const build *B, fcm_index c, int *kept_faces)
+{
+  const int no_work = !B->region[c] || (B->same_links && B->same_links[c]) ||
+                      (B->keep && B->prev && B->prev->piece_off[c + 1] == B->prev->piece_off[c]);
+  *kept_faces = !no_work && B->keep && B->prev->face_nfp && B->prev->face_nfp[c] >= 0;
+  return no_work || *kept_faces;
+}
+
 /* Intersect, classify and build the rules of background cell c into o (the thread's own
  * buffers); R->cls[c] and R->fraction[c] are written here (one writer per cell). Cells the
  * cuts reach are split into material pieces first; each piece then takes the
@@ -421,16 +434,9 @@ static fcm_status process_cell(const build *B, fcm_cell_rules *R, fcm_index c, f
   const int integrate = !B->rebuild || B->rebuild[c];
   const int own = !opt->cell_mask || opt->cell_mask[c]; /* 0: classified, no points */
   double sbox[6];
-  /* a cell the new cut does not reach needs no work outside the region, where its links with
-   * every region neighbour are kept, or where it has no pieces (the links skip such a cell: its
-   * face polygons would be read by no cut until one reaches it and makes them again) */
-  const int no_work =
-      !integrate && (!B->region[c] || (B->same_links && B->same_links[c]) ||
-                     (B->keep && B->prev && B->prev->piece_off[c + 1] == B->prev->piece_off[c]));
-  /* a region cell the new cut does not reach, with the face polygons the earlier cut kept */
-  const int kept_faces =
-      !integrate && !no_work && B->keep && B->prev->face_nfp && B->prev->face_nfp[c] >= 0;
-  if (no_work || kept_faces) return copy_prev_cell(B, R, c, own, kept_faces, ws, o);
+  int kept_faces = 0;
+  if (!integrate && copied_cell(B, c, &kept_faces))
+    return copy_prev_cell(B, R, c, own, kept_faces, ws, o);
   const double t0 = fcm_wtime();
   FCM_TRY(ctx, fcm__embed_cell_setup(ctx, B->mesh, c, opt->clip_rtol, &cell));
   if (R->cell_volume) R->cell_volume[c] = cell.volume;

@@ -23,7 +23,9 @@ void fcm__assembly_corot_free(fcm_assembly_workspace *ws)
 }
 
 /* A new store, each element at its own slot, with a quarter more slots for the elements of
- * later cuts (fcm__assembly_corot_take(); address space only for a large store). */
+ * later cuts (fcm__assembly_corot_take()). A slot is read only once its element's matrix is
+ * built there (have), so the arrays are not zero filled: the slots no element uses are
+ * address space only. */
 static fcm_status store_alloc(fcm_assembly_workspace *ws)
 {
   fcm_status st = FCM_OK;
@@ -32,8 +34,8 @@ static fcm_status store_alloc(fcm_assembly_workspace *ws)
   const fcm_index ne = s->num_elems;
   c->cb = 9 * (size_t)s->nn * (size_t)(s->nn + 1) / 2;
   c->cap = ne + ne / 4 + 1;
-  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)c->cap * c->cb, c->K);
-  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)c->cap * 3 * s->nn, c->G);
+  FCM__ALLOC_WITH(fcm__malloc_large, ws->ctx, (size_t)c->cap * c->cb, c->K);
+  FCM__ALLOC_WITH(fcm__malloc_large, ws->ctx, (size_t)c->cap * 3 * s->nn, c->G);
   FCM_ALLOC(ws->ctx, (size_t)ne + 1, c->have);
   FCM_ALLOC_RAW(ws->ctx, (size_t)ne + 1, c->slot);
   for (fcm_index e = 0; e < ne; e++)
@@ -135,13 +137,17 @@ cleanup:
 
 /* The slots of ws's elements in old's store: a kept element (same[e] >= 0, built in old) keeps
  * its parent's slot, the others take the free slots in ascending order. 0 (nothing written)
- * when the free slots do not suffice. used: old's cap flags, zero. */
+ * when the free slots do not suffice or two elements name one parent. used: old's cap flags,
+ * zero. */
 static int take_slots(const corot_store *o, fcm_index ne, const fcm_index *same, corot_store *c,
                       unsigned char *used)
 {
   fcm_index kept = 0, next = 0;
   for (fcm_index e = 0; e < ne; e++)
-    if (same[e] >= 0 && o->have[same[e]]) used[o->slot[same[e]]] = 1, kept++;
+    if (same[e] >= 0 && o->have[same[e]]) {
+      if (used[o->slot[same[e]]]) return 0; /* two elements would share one matrix */
+      used[o->slot[same[e]]] = 1, kept++;
+    }
   if (ne > o->cap) return 0; /* ne - kept new slots among the cap - kept free ones */
   for (fcm_index e = 0; e < ne; e++) {
     const fcm_index f = same[e];

@@ -120,7 +120,10 @@ static fcm_status build_block_elems(fcm_space *s)
     for (fcm_index i = b * FCM__SPACE_BLOCK; i < FCM_MIN(nbc, (b + 1) * FCM__SPACE_BLOCK); i++) {
       const fcm_index c = s->block_cells[i], n = s->cell_elem[c + 1] - s->cell_elem[c];
       const fcm_index e0 = first ? first[c] : s->cell_elem[c];
-      for (fcm_index e = 0; e < n && j < s->num_local_elems; e++)
+      FCM_CHECK(j + n <= s->num_local_elems, ctx, FCM_ERR_INTERNAL,
+                "space: the blocks' cells hold more than the %lld local elements",
+                (long long)s->num_local_elems);
+      for (fcm_index e = 0; e < n; e++)
         s->block_elems[j++] = e0 + e;
     }
     s->block_ptr[b + 1] = j;

@@ -106,6 +106,9 @@ fcm_status fcm_mg_cycle(fcm_mg *m, const double *b, double *x)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m ? m->ctx : NULL;
   FCM_CHECK(m && b && x && b != x, ctx, FCM_ERR_ARG, "mg_cycle: NULL or overlapping argument");
+  FCM_CHECK(!m->setup_failed, ctx, FCM_ERR_ARG,
+            "mg_cycle: the last fcm_mg_setup() failed, so the levels' values are not one set: "
+            "set the hierarchy up again");
   FCM_TRY(ctx, cycle(m, 0, b, x));
 cleanup:
   return st;
@@ -188,6 +191,9 @@ fcm_status fcm_mg_solve(fcm_mg *m, const double *b, double *x, double rtol, int 
   FCM_CHECK(m && b && x && b != x, ctx, FCM_ERR_ARG, "mg_solve: NULL or overlapping argument");
   FCM_CHECK(rtol >= 0.0 && max_cycles >= 0, ctx, FCM_ERR_ARG,
             "mg_solve: rtol = %g must be >= 0 and max_cycles = %d >= 0", rtol, max_cycles);
+  FCM_CHECK(!m->setup_failed, ctx, FCM_ERR_ARG,
+            "mg_solve: the last fcm_mg_setup() failed, so the levels' values are not one set: "
+            "set the hierarchy up again");
   mg_level *L = &m->lev[0];
   const fcm_index n = L->n;
   const double bn = norm2(n, b);

@@ -119,6 +119,7 @@ struct fcm_mg {
   fcm__mg_kept kept;  /* what fcm__mg_create_from() took from the earlier hierarchy */
   int values_pending; /* created on a pattern (fcm__mg_create_pattern()): no value set up yet */
   long long setups;   /* fcm_mg_setup() calls since the creation (coarse_interval) */
+  int setup_failed;   /* the last fcm_mg_setup() failed: the levels' values are not one set */
   /* the space whose pattern level 0's matrix had at creation (fcm__mg_pattern_of()), NULL
    * for none; kept by fcm__mg_detach(), only compared */
   const fcm_space *pattern_of;

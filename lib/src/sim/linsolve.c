@@ -304,7 +304,7 @@ static fcm_status mg_soft(fcm_integrator *I, fcm_status s, fcm_step_reason *reas
 
 /* The hierarchy on A with A's current values: created at first use and when the matrix or
  * the active constraints changed (the eliminated rows are the multigrid's Dirichlet boundary),
- * else fcm_mg_setup() (Galerkin matrices and the coarsest factorization only). A setup that
+ * else fcm_mg_setup() (new values on the same structure). A setup that
  * finds other eliminated rows (a row whose coupling vanished numerically) builds the hierarchy
  * again. A hierarchy built again takes what is unchanged from the earlier one
  * (fcm__mg_create_from(): the same bits as fcm_mg_create()), which forgets its matrix first

@@ -15,7 +15,7 @@
  *
  * Created for the multigrid's block smoother (fcm__schwarz_create_blocks()), a setup computes
  * only what the block sweeps read, the S_K: no diagonal outside the blocks, no apply. */
-#include "solve/solve_impl.h"
+#include "solve/schwarz_impl.h"
 #include "core/multiversion.h"
 
 #include <math.h>
@@ -31,49 +31,6 @@
 /* The largest eps ||C_K||_F ||C_K^{-1}||_F of a block inverted through its Cholesky factor
  * (cholesky_inverse()): a condition bound 1000 times below the clamping threshold. */
 #define SCHWARZ_CHOLESKY_COND 1e-3
-
-struct fcm_schwarz {
-  fcm_ctx *ctx;
-  fcm_index n;
-  fcm_schwarz_options opts;
-  fcm_index num_blocks;
-  fcm_index *block_ptr;  /* num_blocks + 1 */
-  fcm_index *dofs;       /* block_ptr[num_blocks] */
-  size_t *s_off;         /* num_blocks + 1 offsets into S */
-  double *S;             /* S_K: m x m each (symmetric); a block smoother's (blocks_only) the
-                            lower triangle packed by rows (FCM__SCHWARZ_PACKED) */
-  size_t *pos_off;       /* num_blocks + 1 offsets into pos */
-  int *pos;              /* m (m + 1) / 2 each, packed by rows (FCM__SCHWARZ_PACKED(i, j),
-                            j <= i): where C_K's entry (i, j) lies in C's row dofs[i] (-1:
-                            none); the lower triangle is all the gathers read */
-  unsigned char *full;   /* num_blocks: every entry of C_K's lower triangle is stored (pos
-                            holds them all) */
-  unsigned char *factor; /* blocks_only, num_blocks: S's slot holds X = L^{-1} of the Cholesky
-                            factor C_K = L L^T (its lower triangle), S_K = X^T X */
-  int max_m;
-  int num_colors;        /* of the block graph (statistics only; 0 when blocks_only) */
-  fcm_index *inc_ptr;    /* n + 1: DOF i is row inc_row[q] of block inc_blk[q], q in range
-                            (NULL when blocks_only, as inc_blk, inc_row and dinv) */
-  fcm_index *inc_blk;    /* block_ptr[num_blocks], ascending blocks per DOF */
-  int *inc_row;          /* block_ptr[num_blocks] */
-  unsigned char *inside; /* n: DOF belongs to a block */
-  double *dinv;          /* n: 1/|c_ii| outside the blocks, 0 inside */
-  fcm_index *diag;       /* n: position of c_ii in C at creation outside the blocks (-1: none) */
-  int blocks_only;       /* the block smoother's: the S_K only (no dinv, no apply) */
-  fcm_index carried;     /* blocks whose positions were copied from a prior's */
-  fcm_schwarz_info info;
-  int ready;
-  /* Setup scratch, allocated at creation so a setup allocates nothing: per thread (nt of
-   * them) a max_m^2 block, max_m eigenvalues and lwork doubles of eigensolver workspace, at
-   * least the 2 max_m^2 of the Cholesky path (per_thread doubles in all), liwork ints, and
-   * n ints of the gather's DOF map (zero between blocks). */
-  int nt;
-  size_t per_thread, lwork, liwork;
-  size_t scalar_work; /* the per-thread doubles build_block() uses; build_batch()'s after them */
-  double *work;
-  int *iwork;
-  int *loc;
-};
 
 fcm_schwarz_options fcm_schwarz_options_default(void)
 {
@@ -158,9 +115,6 @@ cleanup:
   fcm__free(ctx, mark);
   return st;
 }
-
-/* Blocks above which the scan of their positions is shared by the threads. */
-#define SCAN_PARALLEL_BLOCKS 256
 
 /* Why one block failed during the parallel setup. */
 typedef enum block_fail { FAIL_NONE, FAIL_NONFINITE, FAIL_ZERO, FAIL_LAPACK } block_fail;
@@ -672,176 +626,16 @@ fcm_status fcm__schwarz_setup_known(fcm_schwarz *P, const fcm_csr *C)
   return setup(P, C, 1);
 }
 
-/* Do block rows i, i + 1, i + 2 hold a node's three DOFs (d[i] = 3 k, d[i + 1] = 3 k + 1,
- * d[i + 2] = 3 k + 2) whose rows of C share one pattern (tri: C's rows' flags,
- * FCM__SCHWARZ_ROWS_SAME at 3 k, or NULL: compared here)? */
-static int rows_triple(const fcm_index *rp, const int *ci, const unsigned char *tri, int m,
-                       const fcm_index *d, int i)
+/* A new P's first values: its set-up, or with values_later its positions alone, copied from
+ * prior's blocks where it has them and found from C's pattern elsewhere. */
+static fcm_status first_values(fcm_schwarz *P, const fcm_csr *C, int values_later,
+                               const unsigned char *tri, const fcm__schwarz_prior *prior)
 {
-  const fcm_index r = d[i];
-  if (r % 3 != 0 || i + 2 >= m || d[i + 1] != r + 1 || d[i + 2] != r + 2) return 0;
-  if (tri) return tri[r] != 0;
-  const fcm_index len = rp[r + 1] - rp[r];
-  return rp[r + 2] - rp[r + 1] == len && rp[r + 3] - rp[r + 2] == len &&
-         !memcmp(ci + rp[r], ci + rp[r + 1], sizeof *ci * (size_t)len) &&
-         !memcmp(ci + rp[r], ci + rp[r + 2], sizeof *ci * (size_t)len);
-}
-
-/* Row r's positions of the block's columns 0 .. last into row (-1 where none; loc: DOF ->
- * block column + 1); cnt[t]: those new in columns 0 .. i + t. Where the row's columns come in
- * whole nodes and so do the block's DOFs (nodes), one look-up a node: a node's first DOF
- * outside the block has its other two outside too, and inside, they follow it. */
-static void scan_row(const fcm_index *rp, const int *ci, fcm_index r, const int *loc, int nodes,
-                     int i, int last, int *row, size_t cnt[3])
-{
-  const int step = nodes ? 3 : 1;
-  for (fcm_index p = rp[r]; p < rp[r + 1]; p += step) {
-    const int k = loc[ci[p]];
-    if (!k) continue;
-    for (int c = 0; c < step && k - 1 + c <= last; c++) {
-      const int j = k - 1 + c;
-      if (row[j] < 0)
-        for (int t = FCM_MAX(j - i, 0); t < 3; t++)
-          cnt[t]++;
-      row[j] = (int)(p + c - rp[r]);
-    }
-  }
-}
-
-/* gather_scan()'s positions (pos, *full) from C's pattern alone (tri: C's rows' flags, or
- * NULL). Where rows i, i + 1, i + 2 are a node's three (rows_triple()), rows i + 1 and i + 2
- * of pos begin with row i's (a position is counted from its row's start): row i is read once,
- * to the block's column i + 2, into packed row i + 2, whose beginnings rows i and i + 1 take. */
-static void scan_pattern(const fcm_csr *C, const unsigned char *tri, int m, const fcm_index *d,
-                         int *loc, int *pos, unsigned char *full)
-{
-  const fcm_index *rp = fcm_csr_row_ptr(C);
-  const int *ci = fcm_csr_col_idx(C);
-  size_t stored = 0;
-  int whole = tri && m % 3 == 0; /* the block's DOFs come in whole nodes */
-  for (int j = 0; whole && j < m; j += 3)
-    whole = d[j] % 3 == 0 && d[j + 1] == d[j] + 1 && d[j + 2] == d[j] + 2;
-  for (size_t e = 0; e < FCM__SCHWARZ_PACKED(m, 0); e++)
-    pos[e] = -1;
-  for (int j = 0; j < m; j++)
-    loc[d[j]] = j + 1;
-  for (int i = 0; i < m; i++) {
-    const int triple = rows_triple(rp, ci, tri, m, d, i), last = triple ? i + 2 : i;
-    const int nodes = whole && triple && tri[d[i]] == FCM__SCHWARZ_ROWS_NODES;
-    int *row = pos + FCM__SCHWARZ_PACKED(last, 0);
-    size_t cnt[3] = {0, 0, 0}; /* stored in rows i, i + 1, i + 2 */
-    scan_row(rp, ci, d[i], loc, nodes, i, last, row, cnt);
-    stored += cnt[0];
-    if (triple) {
-      memcpy(pos + FCM__SCHWARZ_PACKED(i, 0), row, sizeof *row * (size_t)(i + 1));
-      memcpy(pos + FCM__SCHWARZ_PACKED(i + 1, 0), row, sizeof *row * (size_t)(i + 2));
-      stored += cnt[1] + cnt[2];
-      i += 2;
-    }
-  }
-  for (int j = 0; j < m; j++)
-    loc[d[j]] = 0;
-  *full = stored == FCM__SCHWARZ_PACKED(m, 0);
-}
-
-/* The positions of every block's entries in C's rows, as gather_scan() finds them, from C's
- * pattern alone (a creation without values): the first setup gathers the blocks whose entries
- * are all stored through them (the same values as a scan), and scans the others. Blocks shared
- * by the threads, each with its DOF map (zero between blocks). */
-static void scan_positions(fcm_schwarz *P, const fcm_csr *C, const unsigned char *tri)
-{
-  const fcm_index nb = P->num_blocks;
-#pragma omp parallel num_threads(P->nt) if (P->nt > 1 && nb > SCAN_PARALLEL_BLOCKS)
-  {
-    int *loc = P->loc + (size_t)P->n * (size_t)omp_get_thread_num();
-#pragma omp for schedule(dynamic, 64)
-    for (fcm_index b = 0; b < nb; b++)
-      scan_pattern(C, tri, (int)(P->block_ptr[b + 1] - P->block_ptr[b]), P->dofs + P->block_ptr[b],
-                   loc, P->pos + P->pos_off[b], &P->full[b]);
-  }
-}
-
-/* The old blocks by their first DOF (CSR over old's rows), for positions_from(). */
-static fcm_status old_by_first(fcm_ctx *ctx, const fcm_schwarz *old, fcm_index **ptr_out,
-                               fcm_index **blk_out)
-{
-  fcm_status st = FCM_OK;
-  fcm_index *ptr = NULL, *blk = NULL;
-  const fcm_index nb = old->num_blocks;
-  FCM_ALLOC(ctx, old->n + 2, ptr);
-  FCM_ALLOC_RAW(ctx, nb + 1, blk); /* every entry written below */
-  for (fcm_index b = 0; b < nb; b++)
-    ptr[old->dofs[old->block_ptr[b]] + 2]++;
-  for (fcm_index i = 0; i < old->n; i++)
-    ptr[i + 2] += ptr[i + 1];
-  for (fcm_index b = 0; b < nb; b++)
-    blk[ptr[old->dofs[old->block_ptr[b]] + 1]++] = b;
-  *ptr_out = ptr, *blk_out = blk;
-  ptr = blk = NULL;
-cleanup:
-  fcm__free(ctx, ptr);
-  fcm__free(ctx, blk);
-  return st;
-}
-
-/* The old block whose positions are block b's (-1: none): its DOFs block b's mapped
- * (row_old) one by one, and every row of block b the old one's mapped, column for column in
- * the same order (same, per node: 3 rows; the positions, counted from a row's start, are then
- * the same). */
-static fcm_index old_block(const fcm_schwarz *P, const fcm__schwarz_prior *pr,
-                           const fcm_index *optr, const fcm_index *oblk, fcm_index b)
-{
-  const fcm_schwarz *old = pr->old;
-  const fcm_index *d = P->dofs + P->block_ptr[b], m = P->block_ptr[b + 1] - P->block_ptr[b];
-  const fcm_index f = pr->row_old[d[0]];
-  if (f < 0) return -1;
-  for (fcm_index j = 0; j < m; j++)
-    if (!pr->same[d[j] / 3]) return -1;
-  for (fcm_index q = optr[f]; q < optr[f + 1]; q++) {
-    const fcm_index ob = oblk[q], *od = old->dofs + old->block_ptr[ob];
-    if (old->block_ptr[ob + 1] - old->block_ptr[ob] != m) continue;
-    fcm_index j = 1;
-    while (j < m && pr->row_old[d[j]] == od[j])
-      j++;
-    if (j == m) return ob;
-  }
-  return -1;
-}
-
-/* scan_positions(), the positions of the blocks that are old blocks mapped (old_block())
- * copied from them. */
-static fcm_status positions_from(fcm_schwarz *P, const fcm_csr *C, const unsigned char *tri,
-                                 const fcm__schwarz_prior *pr)
-{
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = P->ctx;
-  fcm_index *optr = NULL, *oblk = NULL, carried = 0;
-  const fcm_index nb = P->num_blocks;
-  FCM_TRY(ctx, old_by_first(ctx, pr->old, &optr, &oblk));
-#pragma omp parallel num_threads(P->nt) if (P->nt > 1 && nb > SCAN_PARALLEL_BLOCKS) \
-    reduction(+ : carried)
-  {
-    int *loc = P->loc + (size_t)P->n * (size_t)omp_get_thread_num();
-#pragma omp for schedule(dynamic, 64)
-    for (fcm_index b = 0; b < nb; b++) {
-      const fcm_index ob = old_block(P, pr, optr, oblk, b);
-      const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
-      if (ob >= 0) {
-        memcpy(P->pos + P->pos_off[b], pr->old->pos + pr->old->pos_off[ob],
-               sizeof *P->pos * FCM__SCHWARZ_PACKED(m, 0));
-        P->full[b] = pr->old->full[ob];
-        carried++;
-      } else {
-        scan_pattern(C, tri, m, P->dofs + P->block_ptr[b], loc, P->pos + P->pos_off[b],
-                     &P->full[b]);
-      }
-    }
-  }
-  P->carried = carried;
-cleanup:
-  fcm__free(ctx, optr);
-  fcm__free(ctx, oblk);
-  return st;
+  if (!values_later) return fcm_schwarz_setup(P, C);
+  if (prior && prior->old && prior->old->pos && prior->old->blocks_only)
+    return fcm__schwarz_positions_from(P, C, tri, prior);
+  fcm__schwarz_scan_positions(P, C, tri);
+  return FCM_OK;
 }
 
 /* fcm_schwarz_create(); blocks_only: for the block smoother (fcm__schwarz_create_blocks()),
@@ -959,12 +753,7 @@ static fcm_status create(fcm_ctx *ctx, const fcm_csr *C, fcm_index num_blocks,
   P->info.num_colors = P->num_colors;
   for (fcm_index i = 0; i < nr; i++)
     P->info.outside_dofs += !P->inside[i];
-  if (values_later && prior && prior->old && prior->old->pos && prior->old->blocks_only)
-    FCM_TRY(ctx, positions_from(P, C, tri, prior));
-  else if (values_later)
-    scan_positions(P, C, tri);
-  else
-    FCM_TRY(ctx, fcm_schwarz_setup(P, C));
+  FCM_TRY(ctx, first_values(P, C, values_later, tri, prior));
   *out = P;
   P = NULL;
 cleanup:
@@ -994,22 +783,6 @@ fcm_status fcm__schwarz_create_blocks_pattern(fcm_ctx *ctx, const fcm_csr *C, fc
                                               const fcm__schwarz_prior *prior, fcm_schwarz **out)
 {
   return create(ctx, C, num_blocks, block_ptr, block_dofs, NULL, 1, 1, row_triple, prior, out);
-}
-
-fcm_index fcm__schwarz_carried(const fcm_schwarz *P)
-{
-  return P ? P->carried : 0;
-}
-
-int fcm__schwarz_same_positions(const fcm_schwarz *a, const fcm_schwarz *b)
-{
-  if (!a || !b || a->num_blocks != b->num_blocks || !a->pos || !b->pos) return 0;
-  const fcm_index nb = a->num_blocks;
-  if (memcmp(a->block_ptr, b->block_ptr, sizeof *a->block_ptr * (size_t)(nb + 1)) != 0 ||
-      memcmp(a->dofs, b->dofs, sizeof *a->dofs * (size_t)a->block_ptr[nb]) != 0 ||
-      memcmp(a->full, b->full, (size_t)nb) != 0)
-    return 0;
-  return memcmp(a->pos, b->pos, sizeof *a->pos * a->pos_off[nb]) == 0;
 }
 
 fcm_status fcm_schwarz_apply(const fcm_schwarz *P, const double *r, double *z)

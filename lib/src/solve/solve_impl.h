@@ -76,5 +76,7 @@ fcm_index fcm__schwarz_carried(const fcm_schwarz *P);
 /* 1 when a and b hold the same blocks with the same positions and full flags (both found,
  * no setup since: a setup may scan a block again), else 0. For the tests. */
 int fcm__schwarz_same_positions(const fcm_schwarz *a, const fcm_schwarz *b);
+/* The positions of P's blocks (*count of them), writable: for the tests' controls. */
+int *fcm__schwarz_positions(fcm_schwarz *P, size_t *count);
 
 #endif /* FCM_SOLVE_IMPL_H */
