@@ -10,6 +10,7 @@
  * space built anew on the same rules has the same arrays; on a larger box the cut space takes
  * the rows of 95 % or more of the copies away from the cut (their elements keep their places
  * in the visit). Usage: fem_block_colors */
+#include "cut_away.h"
 #include "fem/fem_impl.h"
 #include "test.h"
 
@@ -106,32 +107,15 @@ static void octree(void)
  * otherwise). *num_away: their number. */
 static double away_share(const fcm_space *s0, const fcm_space *s1, fcm_index *num_away)
 {
-  const fcm_index *cells = fcm_mesh_cells(s1->mesh), ne = s1->num_elems, ncopy = s1->num_dofs / 3;
-  const int nn = s1->nn;
-  fcm_index *same = malloc(sizeof *same * (size_t)(ne + 1)), away = 0, taken = 0;
-  unsigned char *near = calloc((size_t)fcm_mesh_num_nodes(s1->mesh) + 1, 1);
-  unsigned char *close = calloc((size_t)ncopy + 1, 1);
-  TEST_OK(ctx, fcm__space_cut_same_elements(s0, s1, same, NULL));
-  for (fcm_index c = 0; c < s1->num_cells; c++) {
-    int reached =
-        s1->cell_elem[c + 1] - s1->cell_elem[c] != s0->cell_elem[c + 1] - s0->cell_elem[c];
-    for (fcm_index e = s1->cell_elem[c]; e < s1->cell_elem[c + 1]; e++)
-      reached |= same[e] < 0;
-    for (int a = 0; a < nn && reached; a++)
-      near[cells[c * nn + a]] = 1;
-  }
-  for (fcm_index e = 0; e < ne; e++) {
-    int touch = 0;
-    for (int a = 0; a < nn; a++)
-      touch |= near[cells[s1->elem_cell[e] * nn + a]];
-    for (int a = 0; a < nn && touch; a++)
-      close[s1->elem_dof[e * nn + a] / 3] = 1;
-  }
+  const fcm_index ncopy = s1->num_dofs / 3;
+  unsigned char *away = malloc((size_t)ncopy + 1);
+  const fcm_index n = cut_away_copies(ctx, s0, s1, away);
+  fcm_index taken = 0;
   for (fcm_index k = 0; k < ncopy; k++)
-    if (!close[k]) away++, taken += s1->cut_row_from && s1->cut_row_from[k] >= 0;
-  free(same), free(near), free(close);
-  *num_away = away;
-  return away ? (double)taken / (double)away : 0.0;
+    taken += away[k] && s1->cut_row_from && s1->cut_row_from[k] >= 0;
+  free(away);
+  *num_away = n;
+  return n ? (double)taken / (double)n : 0.0;
 }
 
 /* A Hex8 box of 8,000 cells (63 blocks) with an embedded box cut by a plane through its

@@ -14,6 +14,7 @@
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
 #include "sim/sim_impl.h"
+#include "cut_away.h"
 #include "sim_util.h"
 #include "test_alloc.h"
 
@@ -55,41 +56,6 @@ static const double *mass_values(const fcm_integrator *I, fcm_index *nnz)
   return fcm_csr_values_read(fcm_integrator_mass(I));
 }
 
-/* The copies of `to` away from the cut from `from` (flags in away, ncopy entries): no element
- * using the copy lies in a cell touching a node of a cell the cut reached (a cell with other
- * elements, or an element integrated otherwise: fcm__space_cut_same_elements()). Found from
- * the cells alone, not from the space's cut_row_from or the integrator's rows. Their count. */
-static fcm_index away_copies(const fcm_space *from, const fcm_space *to, unsigned char *away)
-{
-  const fcm_index *cells = fcm_mesh_cells(to->mesh), ne = to->num_elems, ncopy = to->num_dofs / 3;
-  const int nn = to->nn;
-  fcm_index *same = malloc(sizeof *same * (size_t)(ne + 1)), count = 0;
-  unsigned char *near = calloc((size_t)fcm_mesh_num_nodes(to->mesh) + 1, 1);
-  TEST_OK(ctx, fcm__space_cut_same_elements(from, to, same, NULL));
-  for (fcm_index k = 0; k < ncopy; k++)
-    away[k] = 1;
-  for (fcm_index c = 0; c < to->num_cells; c++) {
-    int reached =
-        to->cell_elem[c + 1] - to->cell_elem[c] != from->cell_elem[c + 1] - from->cell_elem[c];
-    for (fcm_index e = to->cell_elem[c]; e < to->cell_elem[c + 1]; e++)
-      reached |= same[e] < 0;
-    for (int a = 0; a < nn && reached; a++)
-      near[cells[c * nn + a]] = 1;
-  }
-  for (fcm_index e = 0; e < ne; e++) {
-    int touch = 0;
-    for (int a = 0; a < nn; a++)
-      touch |= near[cells[to->elem_cell[e] * nn + a]];
-    for (int a = 0; a < nn && touch; a++)
-      away[to->elem_dof[e * nn + a] / 3] = 0;
-  }
-  for (fcm_index k = 0; k < ncopy; k++)
-    count += away[k];
-  free(same);
-  free(near);
-  return count;
-}
-
 /* The cut integrator c against one built from scratch on its space, in old's state. */
 static void compare_fresh(const fcm_integrator *old, const fcm_integrator *c, const fcm_mesh *mesh)
 {
@@ -108,11 +74,11 @@ static void compare_fresh(const fcm_integrator *old, const fcm_integrator *c, co
   TEST_TRUE(same_bits(c->Ma, f->Ma, n));
   TEST_TRUE(same_bits(c->u, f->u, n) && same_bits(c->v, f->v, n));
   /* the patch ran: some copies' rows taken, the cut's neighbourhood summed again; at least as
-   * many as 95 % of the copies away from the cut (away_copies(): the cut leaves every row
+   * many as 95 % of the copies away from the cut (cut_away_copies(): the cut leaves every row
    * there, fem_block_colors) */
   const fcm_index ncopy = n / 3;
   unsigned char *away = malloc((size_t)ncopy + 1);
-  const fcm_index num_away = away_copies(old->space, c->space, away);
+  const fcm_index num_away = cut_away_copies(ctx, old->space, c->space, away);
   if (getenv("FCM_TEST_VERBOSE"))
     printf("  copies taken %lld of %lld, away from the cut %lld\n", (long long)c->cut_kept_copies,
            (long long)ncopy, (long long)num_away);
@@ -194,7 +160,7 @@ static void tampered(fcm_integrator *b, const fcm_space *t)
   const double *cv = fcm_csr_values_read(c->M);
   const fcm_index ncopy = c->n / 3;
   unsigned char *away = malloc((size_t)ncopy + 1);
-  const fcm_index num_away = away_copies(b->space, t, away);
+  const fcm_index num_away = cut_away_copies(ctx, b->space, t, away);
   fcm_index marked = 0, away_taken = 0;
   for (fcm_index r = 0; r < c->n; r++)
     marked += cv[t->row_ptr[r]] == mark;
