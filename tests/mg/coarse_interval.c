@@ -11,18 +11,6 @@
 
 #include <math.h>
 
-static void scale_values(fcm_csr *A, const double *v0, double amp)
-{
-  fcm_index n = 0;
-  fcm_csr_get_size(A, &n, NULL, NULL);
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  double *v = fcm_csr_values(A);
-  for (fcm_index i = 0; i < n; i++)
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      v[p] = (1.0 + amp * sin((double)i)) * (1.0 + amp * sin((double)ci[p])) * v0[p];
-}
-
 /* Whether the values of level l >= 1 of a and b are the same bits. */
 static int same_level(const fcm_mg *a, const fcm_mg *b, int l)
 {
@@ -56,7 +44,7 @@ int main(void)
   double *d0 = malloc(sizeof *d0 * (size_t)n0);
   for (int k = 1; k <= 2; k++) { /* set-ups 2 and 3: level 0 alone */
     memcpy(d0, lag->lev[0].dinv, sizeof *d0 * (size_t)n0);
-    scale_values(p.A, v0, 0.05 * k);
+    scale_symmetric(p.A, v0, 0.05 * k);
     TEST_OK(ctx, fcm_mg_setup(lag));
     for (int l = 1; l < fcm_mg_num_levels(lag); l++)
       TEST_TRUE(same_level(lag, first, l));
@@ -70,7 +58,7 @@ int main(void)
     printf("set-up %d, coarse levels lagged: CG + MG %d iterations\n", k + 1, ki.iterations);
     free(x);
   }
-  scale_values(p.A, v0, 0.2);
+  scale_symmetric(p.A, v0, 0.2);
   TEST_OK(ctx, fcm_mg_setup(lag)); /* set-up 4: every level again */
   o.coarse_interval = 1;
   TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &fresh));
@@ -96,7 +84,7 @@ int main(void)
     double *y = calloc((size_t)p.n, sizeof *y), *y2 = calloc((size_t)p.n, sizeof *y2);
     TEST_ERR(ctx, fcm_mg_cycle(lag, p.b, y), FCM_ERR_ARG, "set the hierarchy up again");
     v[lag->lev[0].diag[0]] = keep;
-    scale_values(p.A, v0, 0.3);
+    scale_symmetric(p.A, v0, 0.3);
     TEST_OK(ctx, fcm_mg_setup(lag));
     fcm_mg_destroy(&fresh);
     TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &fresh));
@@ -110,11 +98,11 @@ int main(void)
     fcm_mg *one = NULL, *one_fresh = NULL;
     o.coarse_dofs = 10 * p.n;
     o.coarse_interval = 2;
-    scale_values(p.A, v0, 0.0);
+    scale_symmetric(p.A, v0, 0.0);
     TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &one));
     if (one) {
       TEST_TRUE(fcm_mg_num_levels(one) == 1);
-      scale_values(p.A, v0, 0.4);
+      scale_symmetric(p.A, v0, 0.4);
       TEST_OK(ctx, fcm_mg_setup(one)); /* set-up 2: not a coarse one */
       TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &one_fresh));
       double *y = calloc((size_t)p.n, sizeof *y), *y2 = calloc((size_t)p.n, sizeof *y2);

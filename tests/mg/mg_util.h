@@ -8,6 +8,7 @@
 #include "fcm/fcm.h"
 #include "test.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -347,6 +348,20 @@ static inline void oct_problem_create(fcm_ctx *ctx, fcm_element_type type, fcm_i
   TEST_OK(ctx, fcm_space_apply_dirichlet(p->space, nd, dofs, NULL, p->A, p->b));
   free(nodes);
   free(dofs);
+}
+
+/* v_ij = s_i s_j a_ij with s_i = 1 + amp sin(i): the same pattern, eliminated rows stay
+ * eliminated (their couplings stay zero), positive definite when A is. */
+static inline void scale_symmetric(fcm_csr *A, const double *v0, double amp)
+{
+  fcm_index n = 0;
+  fcm_csr_get_size(A, &n, NULL, NULL);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  double *v = fcm_csr_values(A);
+  for (fcm_index i = 0; i < n; i++)
+    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+      v[p] = (1.0 + amp * sin((double)i)) * (1.0 + amp * sin((double)ci[p])) * v0[p];
 }
 
 #endif /* FCM_MG_TEST_UTIL_H */

@@ -9,20 +9,6 @@
 
 #include <math.h>
 
-/* v_ij = s_i s_j a_ij with s_i = 1 + amp sin(i): the same pattern, eliminated rows stay
- * eliminated (their couplings stay zero), positive definite when A is. */
-static void scale_symmetric(fcm_csr *A, const double *v0, double amp)
-{
-  fcm_index n = 0;
-  fcm_csr_get_size(A, &n, NULL, NULL);
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
-  double *v = fcm_csr_values(A);
-  for (fcm_index i = 0; i < n; i++)
-    for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-      v[p] = (1.0 + amp * sin((double)i)) * (1.0 + amp * sin((double)ci[p])) * v0[p];
-}
-
 /* One cycle from 0 and a CG + MG solve to 1e-9, as one vector of 2 n. */
 static void run(fcm_ctx *ctx, fcm_mg *mg, const problem *p, double *out)
 {

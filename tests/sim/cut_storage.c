@@ -25,7 +25,6 @@ static fcm_ctx *ctx;
 static failing fl; /* ctx's allocator: counts, fails one allocation where armed */
 
 static const fcm_material mat = {FCM_MATERIAL_COROTATED_LINEAR, 2.0e4, 0.3, 1000.0};
-static const double gravity[3] = {0.0, -9.81, 0.0};
 
 static int same_bits(const double *a, const double *b, fcm_index n)
 {
@@ -34,19 +33,7 @@ static int same_bits(const double *a, const double *b, fcm_index n)
 
 static fcm_integrator *make(const fcm_space *space, const fcm_mesh *mesh, int cut_reuse)
 {
-  fcm_integrator *I = NULL;
-  fcm_integrator_options o = fcm_integrator_options_default();
-  o.dt = 0.01;
-  o.cut_reuse = cut_reuse;
-  o.linear_solver = FCM_LINEAR_MULTIGRID;
-  o.multigrid_fixed_cycles = 3;
-  o.newton_fixed_iterations = 1;
-  const double lo[3] = {-10, -10, -10}, hi[3] = {10, 0.05, 10};
-  TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, &o, &I));
-  TEST_OK(ctx, fcm_integrator_add_gravity(I, gravity, NULL, NULL));
-  TEST_OK(ctx, hold_box(ctx, I, mesh, lo, hi));
-  TEST_OK(ctx, fcm_integrator_setup(I));
-  return I;
+  return cut_chain_integrator(ctx, space, mesh, &mat, cut_reuse);
 }
 
 /* Steps both; the displacement and velocity stay the same bits. */

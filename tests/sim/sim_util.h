@@ -148,6 +148,29 @@ static inline fcm_status hold_box(fcm_ctx *ctx, fcm_integrator *I, const fcm_mes
   return st;
 }
 
+/* The cut tests' corotated integrator (Hex8 chains): material mat, gravity along -y, the nodes
+ * below y = 0.05 held, one Newton iteration of 3 multigrid cycles a step, dt 0.01 s, cuts
+ * taking what cut_reuse (FCM_CUT_REUSE_*) says; set up. */
+static inline fcm_integrator *cut_chain_integrator(fcm_ctx *ctx, const fcm_space *space,
+                                                   const fcm_mesh *mesh, const fcm_material *mat,
+                                                   int cut_reuse)
+{
+  static const double gravity[3] = {0.0, -9.81, 0.0};
+  fcm_integrator *I = NULL;
+  fcm_integrator_options o = fcm_integrator_options_default();
+  o.dt = 0.01;
+  o.cut_reuse = cut_reuse;
+  o.linear_solver = FCM_LINEAR_MULTIGRID;
+  o.multigrid_fixed_cycles = 3;
+  o.newton_fixed_iterations = 1;
+  const double lo[3] = {-10, -10, -10}, hi[3] = {10, 0.05, 10};
+  TEST_OK(ctx, fcm_integrator_create(ctx, space, mat, &o, &I));
+  TEST_OK(ctx, fcm_integrator_add_gravity(I, gravity, NULL, NULL));
+  TEST_OK(ctx, hold_box(ctx, I, mesh, lo, hi));
+  TEST_OK(ctx, fcm_integrator_setup(I));
+  return I;
+}
+
 /* Central differences (step eps) of fcm_integrator_contact_eval() at u (restored on return)
  * and time t along d against its force f0 and Newton matrix T there (T may be NULL): the
  * relative errors of the energy's difference against f0 . d and of the force's against T d
