@@ -468,14 +468,15 @@ static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space 
  * Bunny 2 0.07 s, the values 0.02 s, the surface 0.04 s), then the values, the surface and the
  * log's blocks; on one thread the values come first, as fcm_integrator_create_cut() makes
  * them. None reads what another writes (the structure reads the new integrator's pattern and
- * constraints, which the first stage wrote, and old's hierarchy; the values the old
+ * constraints' DOFs, which the first stage wrote, and old's hierarchy; the values the old
  * integrator and the new space; the surface the new space, its rules and the geometry; the
  * log's blocks the two spaces' elements and mass caches, which only they write), and each
  * gives the bits it gives alone (the loops inside run on one thread then, and give the bits
- * they give on two). A distributed run makes them on the calling thread in turn.
- * seconds[0]: the integrator's wall time without its solver's structure, seconds[1]: that
- * structure's (the direct solver's analysis, made with the values, moved to it); side by
- * side each its own. */
+ * they give on two). A distributed run makes them on the calling thread in turn. A failed
+ * part gives the storage back to the old integrator, which goes on. seconds[1]: the solver's
+ * structure (the structure part's wall time, and the direct solver's symbolic analysis, which
+ * the values make), seconds[0]: the rest of the integrator's; side by side each its own, so
+ * they may add up to more than the cut. */
 static fcm_status cut_parts(fcm_simulation *S, const fcm_space *space, fcm_integrator **integ,
                             double *seconds)
 {
