@@ -174,6 +174,13 @@ endforeach()
 # (the cut cells' rules use one BLAS thread inside their loops whatever the run's count;
 # Hex20's mass fits are large enough for a threaded BLAS product to round differently).
 fcm_add_test(sim_cut_threads_hex20 tests/sim/cut_overlap.c ARGS hex20 threads)
+# With the multigrid solver the cut's solver structure is made beside the integrator's values
+# and the surface: the same bits, the hierarchy that of the state's active set; a cut failing
+# at an allocation (in turn or side by side) leaves the run going on with its integrator.
+foreach(el hex8 hex20)
+  fcm_add_test(sim_cut_overlap_multigrid_${el} tests/sim/cut_overlap.c ARGS ${el} multigrid)
+endforeach()
+fcm_add_test(sim_cut_overlap_fail_hex8 tests/sim/cut_overlap.c ARGS hex8 fail)
 # The integrator of a cut onto a patched space takes the mass rows and load entries the cut
 # leaves from the old integrator (moved within its storage, or copied) and equals one built from
 # scratch bit for bit, over three cuts; a failed cut leaves the old one going on.

@@ -651,7 +651,10 @@ static void setup_initial_state(fcm_integrator *I)
   }
 }
 
-fcm_status fcm_integrator_setup(fcm_integrator *I)
+/* The setup's first stage: the checks, the hanging DOFs, the constraints' DOFs and the
+ * storage with the Newton matrix's pattern, all that the solver's structure needs
+ * (fcm__sim_prepare_solver_cut()). */
+static fcm_status setup_begin(fcm_integrator *I)
 {
   fcm_status st = FCM_OK;
   FCM_CHECK(I, NULL, FCM_ERR_ARG, "integrator: NULL integrator");
@@ -675,6 +678,18 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   FCM_TRY(ctx, fcm__sim_hanging_setup(I));
   FCM_TRY(ctx, build_constraints(I));
   FCM_TRY(ctx, setup_storage(I));
+cleanup:
+  return st;
+}
+
+/* The setup's second stage, the values: the scheme, Nitsche's boundary, the mass matrix and
+ * the loads, the representative force, the linear solver, the state and contact. It leaves
+ * what setup_begin() wrote and the hierarchy's fields (I->mg, mg_A, mg_con, mg_creations)
+ * as they are. */
+static fcm_status setup_values(fcm_integrator *I)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
   FCM_TRY(ctx, fcm__sim_scheme_setup(I));
   FCM_TRY(ctx, fcm__sim_boundary_setup(I));
   FCM_TRY(ctx, setup_mass_and_loads(I));
@@ -684,6 +699,13 @@ fcm_status fcm_integrator_setup(fcm_integrator *I)
   setup_initial_state(I);
   FCM_TRY(ctx, fcm__sim_contact_setup(I));
 cleanup:
+  return st;
+}
+
+fcm_status fcm_integrator_setup(fcm_integrator *I)
+{
+  fcm_status st = setup_begin(I);
+  if (st == FCM_OK) st = setup_values(I);
   return st;
 }
 
@@ -703,20 +725,21 @@ fcm_status fcm__sim_copy_effects(const fcm_integrator *old, fcm_integrator *I)
   return st;
 }
 
-fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
-                                     fcm_integrator **integ)
+fcm_status fcm__integrator_cut_begin(const fcm_integrator *old, const fcm_space *space,
+                                     fcm__integrator_cut *cut)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = old ? old->ctx : NULL;
-  fcm_integrator *I = NULL, *giver = NULL;
-  double *u = NULL, *v = NULL, *a = NULL;
-  FCM_CHECK(integ, ctx, FCM_ERR_ARG, "integrator cut: output pointer is NULL");
-  *integ = NULL;
+  fcm_integrator *I = NULL;
+  const double t0 = fcm_wtime();
+  memset(cut, 0, sizeof *cut);
+  cut->old = old;
   FCM_CHECK(old && space, ctx, FCM_ERR_ARG, "integrator cut: NULL integrator or space");
   FCM_CHECK(old->is_setup, ctx, FCM_ERR_ARG,
             "integrator cut: the integrator must be set up (fcm_integrator_setup())");
   /* with a backend (fem/fem_backend.h) a local failure goes into its setup, which agrees */
-  st = fcm_integrator_create(ctx, space, &old->mat, &old->opts, &I);
+  st = fcm_integrator_create(ctx, space, &old->mat, &old->opts, &cut->integ);
+  I = cut->integ;
   if (st == FCM_OK) st = fcm__sim_copy_effects(old, I);
   for (int k = 0; st == FCM_OK && k < old->num_cons; k++)
     st = fcm_integrator_add_constraint(I, old->cons[k].num_nodes, old->cons[k].nodes,
@@ -733,8 +756,22 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   FCM_TRY(ctx, fcm__sim_cut_ordering(old, I));
   FCM_TRY(ctx, fcm__sim_cut_prepare_blocks(old, I));
   fcm__sim_cut_give_storage(old, I);
-  giver = I->cut_give;
-  st = fcm_integrator_setup(I);
+  cut->giver = I->cut_give;
+  FCM_TRY(ctx, setup_begin(I));
+cleanup:
+  cut->seconds[0] += fcm_wtime() - t0;
+  return st;
+}
+
+fcm_status fcm__integrator_cut_values(fcm__integrator_cut *cut)
+{
+  fcm_status st = FCM_OK;
+  fcm_integrator *I = cut->integ;
+  const fcm_integrator *old = cut->old;
+  fcm_ctx *ctx = I->ctx;
+  double *u = NULL, *v = NULL, *a = NULL;
+  const double t0 = fcm_wtime();
+  st = setup_values(I);
   I->cut_old = NULL; /* borrowed for the setup only */
   I->cut_give = NULL;
   FCM_FREE(ctx, I->cut_same);
@@ -744,25 +781,69 @@ fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space 
   FCM_TRY(ctx, st);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, u);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, v);
-  FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->u, u));
-  FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->v, v));
+  FCM_TRY(ctx, fcm_space_transfer(old->space, I->space, old->u, u));
+  FCM_TRY(ctx, fcm_space_transfer(old->space, I->space, old->v, v));
   FCM_TRY(ctx, fcm_integrator_set_state(I, u, v, old->t, old->steps));
   if (old->a_valid) { /* the acceleration too (every new copy inherits its parent's) */
     FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, a);
-    FCM_TRY(ctx, fcm_space_transfer(old->space, space, old->a, a));
+    FCM_TRY(ctx, fcm_space_transfer(old->space, I->space, old->a, a));
     FCM_TRY(ctx, fcm_integrator_set_acceleration(I, a));
   }
-  /* the solver's structure, part of the cut: what the cut left of old's hierarchy taken */
-  FCM_TRY(ctx, fcm__sim_prepare_solver_cut(I, old));
-  I->load_work = old->load_work;
-  *integ = I;
-  I = NULL;
-  if (giver) giver->spent = 1, giver->is_setup = 0; /* its storage is the new integrator's */
 cleanup:
-  if (I && giver) fcm__sim_cut_give_back(I, giver); /* failed: old goes on */
   fcm__free(ctx, u);
   fcm__free(ctx, v);
   fcm__free(ctx, a);
+  cut->seconds[0] += fcm_wtime() - t0;
+  return st;
+}
+
+fcm_status fcm__integrator_cut_structure(fcm__integrator_cut *cut)
+{
+  const double t0 = fcm_wtime();
+  const fcm_status st = fcm__sim_prepare_solver_cut(cut->integ, cut->old, &cut->con);
+  cut->seconds[1] += fcm_wtime() - t0;
+  return st;
+}
+
+fcm_status fcm__integrator_cut_end(fcm__integrator_cut *cut, fcm_status st, fcm_integrator **integ)
+{
+  fcm_integrator *I = cut->integ;
+  fcm_ctx *ctx = cut->old ? cut->old->ctx : NULL;
+  const double t0 = fcm_wtime();
+  *integ = NULL;
+  if (st == FCM_OK) {
+    /* the structure's active set is I's when I's state holds it (always, by
+     * fcm__sim_eval_constraints()); else the first factor builds the hierarchy again */
+    if (I->mg)
+      I->mg_con = cut->con && memcmp(cut->con, I->is_con, (size_t)I->n) == 0 ? I->con_version : -1;
+    I->setup_info.solver_seconds += cut->seconds[1];
+    I->load_work = cut->old->load_work;
+    *integ = I;
+    I = NULL;
+    if (cut->giver) /* its storage is the new integrator's */
+      cut->giver->spent = 1, cut->giver->is_setup = 0;
+  }
+  if (I && cut->giver) fcm__sim_cut_give_back(I, cut->giver); /* failed: old goes on */
+  fcm__free(ctx, cut->con);
   fcm_integrator_destroy(&I);
+  cut->integ = NULL;
+  cut->con = NULL;
+  cut->seconds[0] += fcm_wtime() - t0;
+  return st;
+}
+
+fcm_status fcm_integrator_create_cut(const fcm_integrator *old, const fcm_space *space,
+                                     fcm_integrator **integ)
+{
+  fcm_status st = FCM_OK;
+  fcm__integrator_cut cut;
+  FCM_CHECK(integ, old ? old->ctx : NULL, FCM_ERR_ARG, "integrator cut: output pointer is NULL");
+  *integ = NULL;
+  st = fcm__integrator_cut_begin(old, space, &cut);
+  if (st == FCM_OK) st = fcm__integrator_cut_values(&cut);
+  /* the solver's structure, part of the cut: what the cut left of old's hierarchy taken */
+  if (st == FCM_OK) st = fcm__integrator_cut_structure(&cut);
+  st = fcm__integrator_cut_end(&cut, st, integ);
+cleanup:
   return st;
 }

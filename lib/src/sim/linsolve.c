@@ -335,11 +335,11 @@ static fcm_status mg_prepare(fcm_integrator *I, const fcm_csr *A, fcm_step_reaso
  * constrained DOFs, and the free rows whose every off-diagonal entry of the pattern lies in a
  * constrained column. A coupling that vanishes numerically is not foreseen: the set-up then
  * finds other eliminated rows and builds the hierarchy again (mg_prepare()). */
-static void predicted_eliminated(const fcm_integrator *I, unsigned char *inactive)
+static void predicted_eliminated(const fcm_integrator *I, const unsigned char *con,
+                                 unsigned char *inactive)
 {
   const fcm_index *rp = fcm_csr_row_ptr(I->H);
   const int *ci = fcm_csr_col_idx(I->H);
-  const unsigned char *con = I->is_con;
   for (fcm_index i = 0; i < I->n; i++) {
     int off = 0;
     for (fcm_index p = rp[i]; p < rp[i + 1] && !off && !con[i]; p++)
@@ -348,23 +348,32 @@ static void predicted_eliminated(const fcm_integrator *I, unsigned char *inactiv
   }
 }
 
-/* FCM_LINEAR_MULTIGRID on a serial space without hanging nodes: the hierarchy on H's pattern
- * with the active set of the current time (fcm__mg_create_pattern()), for the first set-up
- * (mg_prepare(): fcm_mg_setup() when that active set holds at the step). */
-static fcm_status mg_structure(fcm_integrator *I, const fcm_integrator *from)
+/* Whether the solver has a structure to prepare: FCM_LINEAR_MULTIGRID on a serial space
+ * without hanging nodes. */
+static int mg_structure_wanted(const fcm_integrator *I)
+{
+  return I->opts.linear_solver == FCM_LINEAR_MULTIGRID && !I->backend.factor && !I->hP &&
+         !I->space->is_local;
+}
+
+/* The solver's structure (mg_structure_wanted()): the hierarchy on H's pattern with the
+ * constrained DOFs `con` (n entries) and its version `version` (mg_con), for the first set-up
+ * (mg_prepare(): fcm_mg_setup() when that active set holds at the step). Reads of I only
+ * what the setup's first stage wrote (options, backend, hanging DOFs, H's pattern) and its
+ * hierarchy's fields, which it alone writes. */
+static fcm_status mg_structure(fcm_integrator *I, const fcm_integrator *from,
+                               const unsigned char *con, long long version)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
   unsigned char *inactive = NULL;
-  if (I->opts.linear_solver != FCM_LINEAR_MULTIGRID || I->backend.factor || I->hP ||
-      I->space->is_local)
-    return FCM_OK;
-  if (I->mg && I->mg_A == I->H && I->mg_con == I->con_version) return FCM_OK;
+  if (!mg_structure_wanted(I)) return FCM_OK;
+  if (I->mg && I->mg_A == I->H && I->mg_con == version) return FCM_OK;
   fcm_mg *old = I->mg;
   I->mg = NULL;
   if (old && I->mg_A != I->H) fcm__mg_detach(old);
   FCM_ALLOC_RAW(ctx, (size_t)I->n + 1, inactive);
-  predicted_eliminated(I, inactive);
+  predicted_eliminated(I, con, inactive);
   /* a cut's: old's hierarchy, made on its Newton matrix (the space's pattern), read */
   const fcm_mg *carry = from && from->mg && from->mg_A == from->H ? from->mg : NULL;
   if (carry && !old)
@@ -373,7 +382,7 @@ static fcm_status mg_structure(fcm_integrator *I, const fcm_integrator *from)
   else
     st = fcm__mg_create_pattern(ctx, &old, I->space, I->H, inactive, &I->opts.multigrid, &I->mg);
   I->mg_A = I->mg ? I->H : NULL;
-  I->mg_con = I->con_version;
+  I->mg_con = version;
   I->mg_creations += I->mg != NULL;
   if (st != FCM_OK) {
     fcm__error_prefix(ctx, "integrator: linear_solver multigrid");
@@ -396,7 +405,7 @@ static fcm_status prepare_solver(fcm_integrator *I, const fcm_integrator *from)
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG,
             "integrator prepare_solver: the integrator must be set up (fcm_integrator_setup())");
   const double t0 = fcm_wtime();
-  st = mg_structure(I, from);
+  st = mg_structure(I, from, I->is_con, I->con_version);
   I->setup_info.solver_seconds += fcm_wtime() - t0;
 cleanup:
   return st;
@@ -407,9 +416,21 @@ fcm_status fcm_integrator_prepare_solver(fcm_integrator *I)
   return prepare_solver(I, NULL);
 }
 
-fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old)
+fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old,
+                                       unsigned char **con)
 {
-  return prepare_solver(I, old);
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = I->ctx;
+  *con = NULL;
+  if (!mg_structure_wanted(I)) return FCM_OK;
+  /* the constrained DOFs at old's time: a constraint's DOFs are marked exactly while it is
+   * active (fcm__sim_eval_constraints()), whatever the evaluations before */
+  FCM_ALLOC(ctx, (size_t)I->n + 1, *con);
+  for (fcm_index i = 0; i < I->ncon; i++)
+    (*con)[I->con_dof[i]] = (unsigned char)fcm_motion_active(&I->cons[I->con_id[i]].motion, old->t);
+  FCM_TRY(ctx, mg_structure(I, old, *con, -1));
+cleanup:
+  return st;
 }
 
 /* Preconditioner set-up: the hierarchy on the preconditioner's matrix P. Once built on Hpc

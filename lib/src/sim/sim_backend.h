@@ -50,4 +50,37 @@ void fcm__integrator_processes(const fcm_integrator *I, int *rank, int *nprocs);
  * none (the serial backend). Collective. */
 fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st);
 
+/* A cut's integrator (fcm_integrator_create_cut()) in stages, for a caller that runs the two
+ * middle ones side by side: fcm__integrator_cut_begin() creates the integrator with old's
+ * effects, constraints and backend and the setup's first stage (the constraints' DOFs, the
+ * storage taken from old, the Newton matrix's pattern); then, independent of each other,
+ * fcm__integrator_cut_values() (the rest of the setup: mass matrix, loads, linear solver;
+ * the state transferred) and fcm__integrator_cut_structure() (the linear solver's structure,
+ * fcm__sim_prepare_solver_cut(): it reads of the new integrator only what the first stage
+ * wrote, the values job none of what it writes); fcm__integrator_cut_end() last, always. Each
+ * stage's loops give the bits they give on any thread count; the result is
+ * fcm_integrator_create_cut()'s bit for bit. */
+typedef struct fcm__integrator_cut {
+  const fcm_integrator *old;
+  fcm_integrator *integ; /* the new integrator (NULL: not created) */
+  fcm_integrator *giver; /* old when it gives its storage (FCM_CUT_REUSE_STORAGE) */
+  unsigned char *con;    /* the structure's constrained DOFs (NULL: no structure) */
+  double seconds[2];     /* wall seconds: [0] begin, values and end, [1] the structure */
+} fcm__integrator_cut;
+
+/* The first stage into *cut (set whatever happens; fcm__integrator_cut_end() must follow). */
+FCM_COMPONENT_API fcm_status fcm__integrator_cut_begin(const fcm_integrator *old,
+                                                       const fcm_space *space,
+                                                       fcm__integrator_cut *cut);
+/* The values job, after a successful begin. */
+FCM_COMPONENT_API fcm_status fcm__integrator_cut_values(fcm__integrator_cut *cut);
+/* The structure job, after a successful begin; beside the values job or before or after it. */
+FCM_COMPONENT_API fcm_status fcm__integrator_cut_structure(fcm__integrator_cut *cut);
+/* The end, st the outcome of the stages run (FCM_OK: every one succeeded): on FCM_OK *integ
+ * the new integrator and a giver spent; else everything of the new integrator freed, the
+ * storage given back to old (fcm__sim_cut_give_back(): old goes on) and *integ NULL. Returns
+ * st. */
+FCM_COMPONENT_API fcm_status fcm__integrator_cut_end(fcm__integrator_cut *cut, fcm_status st,
+                                                     fcm_integrator **integ);
+
 #endif /* FCM_SIM_BACKEND_H */

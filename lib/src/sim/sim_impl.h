@@ -343,8 +343,14 @@ long long fcm__sim_mg_creations(const fcm_integrator *I);
 
 /* fcm_integrator_prepare_solver() of the integrator a cut made from `old` (on the space before
  * the cut): the multigrid hierarchy's structure takes what the cut left from old's hierarchy
- * (fcm__mg_create_pattern_cut(); the same bits), which is only read. (linsolve.c) */
-fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old);
+ * (fcm__mg_create_pattern_cut(); the same bits), which is only read. Needs only the setup's
+ * first stage (fcm__sim_setup_begin()) and reads nothing its value stage writes, so the two
+ * may run side by side: the active set is that of old's time (the state the cut transfers),
+ * computed here into *con (n entries, the caller's to free; NULL: no structure to prepare),
+ * and I->mg_con is left -1 for the caller to set once I's active set is known to be *con.
+ * Adds nothing to I->setup_info.solver_seconds. (linsolve.c) */
+fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old,
+                                       unsigned char **con);
 
 /* External load at time t: sum_k scale_k(t) f_k into f (n). (integrator.c) */
 void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);
