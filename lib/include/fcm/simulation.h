@@ -176,9 +176,12 @@ typedef struct fcm_simulation_counters {
                                    the multigrid hierarchy without values; the next step sets
                                    up the values only (its time_step_factor: the numeric
                                    factorization, Galerkin values, smoothers, coarsest factor) */
-  double time_cut_other;      /**< of time_cuts: the rest (the phases add up to time_cuts): the
-                                   embedded surface split again (with 2+ threads made beside the
-                                   integrator: its time beyond it), the log's mass blocks */
+  double time_cut_other;      /**< of time_cuts: the rest, the embedded surface split again and
+                                   the log's mass blocks. On one thread the phases add up to
+                                   time_cuts; with 2+ threads the integrator's values, the solver
+                                   structure and the surface are made side by side (those two
+                                   phases each its own wall time), and this is what the cut
+                                   took beyond the sum of the others (0 when they overlap) */
   double time_log; /**< seconds of the per-step log rows (mass, momentum, reactions; not part
                         of time_steps) */
   double time_setup_geometry;   /**< seconds of the set-up's background mesh and geometry (reading
