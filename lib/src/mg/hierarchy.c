@@ -140,22 +140,21 @@ typedef struct level0_build {
   fcm_index nnode, ncells, nk;
   const fcm_index *cells;
   const fcm_cell_rules *rules;
-  fcm_index *node2;         /* 3 per mesh node: position on the half grid */
-  fcm_index *cell_ijk;      /* 3 per mesh cell: grid position */
-  fcm_index *grid;          /* per grid position: the mesh cell there, -1: none */
-  unsigned char bits_of[8]; /* corner bits of each local corner node */
-  fcm_index *copy_node;     /* per space copy: its node */
-  fcm_index *cmap;          /* space copy -> grid level copy (-1: none; identity on Hex8) */
-  unsigned char *cut;       /* per mesh cell: cut or split */
+  const fcm_index *node2;       /* the mesh grid's (mg_grid) */
+  const fcm_index *cell_ijk;    /* the mesh grid's */
+  const fcm_index *grid;        /* the mesh grid's cell_at */
+  const unsigned char *bits_of; /* the mesh grid's */
+  fcm_index *copy_node;         /* per space copy: its node */
+  fcm_index *cmap;              /* space copy -> grid level copy (-1: none; identity on Hex8) */
+  unsigned char *cut;           /* per mesh cell: cut or split */
 } level0_build;
 
 /* Grid spacing from cell 0, origin from the bounding box; node positions on the half grid:
  * corners at even, mid-edge nodes at odd coordinates. */
-static fcm_status grid_nodes(level0_build *b)
+static fcm_status grid_nodes(level0_build *b, mg_grid *mgrid)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = b->m->ctx;
-  mg_level *L = b->L;
   const double *X = fcm_mesh_coords(b->mesh);
   double lo[3], hi[3], h[3];
   fcm_mesh_bounding_box(b->mesh, lo, hi);
@@ -167,20 +166,18 @@ static fcm_status grid_nodes(level0_build *b)
     }
     h[d] = mx - mn;
     FCM_CHECK(h[d] > 0.0, ctx, FCM_ERR_UNSUPPORTED, "mg: cell 0 has no extent along axis %d", d);
-    L->grid[d] = (fcm_index)llround((hi[d] - lo[d]) / h[d]);
+    mgrid->grid[d] = (fcm_index)llround((hi[d] - lo[d]) / h[d]);
   }
-  if (b->hex20)
-    b->L0->grid[0] = L->grid[0], b->L0->grid[1] = L->grid[1], b->L0->grid[2] = L->grid[2];
-  FCM_ALLOC(ctx, 3 * b->nnode + 1, b->node2);
+  FCM_ALLOC_RAW(ctx, 3 * b->nnode + 1, mgrid->node2); /* every entry written below */
   for (fcm_index n = 0; n < b->nnode; n++)
     for (int d = 0; d < 3; d++) {
       const double t = 2.0 * (X[3 * n + d] - lo[d]) / h[d];
       const fcm_index r = (fcm_index)llround(t);
-      FCM_CHECK(fabs(t - (double)r) < 2e-6 && r >= 0 && r <= 2 * L->grid[d], ctx,
+      FCM_CHECK(fabs(t - (double)r) < 2e-6 && r >= 0 && r <= 2 * mgrid->grid[d], ctx,
                 FCM_ERR_UNSUPPORTED,
                 "mg: node %lld is not on the grid of spacing %g along axis %d (not a box grid)",
                 (long long)n, h[d], d);
-      b->node2[3 * n + d] = r;
+      mgrid->node2[3 * n + d] = r;
     }
 cleanup:
   return st;
@@ -188,16 +185,15 @@ cleanup:
 
 /* Cell positions, the cell at each grid position and the corner bits of each local corner
  * node; every cell a grid cube with its nodes in cell 0's order, no two overlapping. */
-static fcm_status grid_cells(level0_build *b)
+static fcm_status grid_cells(level0_build *b, mg_grid *mgrid)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = b->m->ctx;
-  const mg_level *L = b->L;
-  const fcm_index *node2 = b->node2;
-  FCM_ALLOC(ctx, 3 * b->ncells + 1, b->cell_ijk);
-  const fcm_index gsize = L->grid[0] * L->grid[1] * L->grid[2];
-  FCM_ALLOC(ctx, gsize + 1, b->grid);
-  fcm_index *cell_ijk = b->cell_ijk, *grid = b->grid;
+  const fcm_index *node2 = mgrid->node2;
+  FCM_ALLOC_RAW(ctx, 3 * b->ncells + 1, mgrid->cell_ijk); /* every entry written below */
+  const fcm_index gsize = mgrid->grid[0] * mgrid->grid[1] * mgrid->grid[2];
+  FCM_ALLOC_RAW(ctx, gsize + 1, mgrid->cell_at);
+  fcm_index *cell_ijk = mgrid->cell_ijk, *grid = mgrid->cell_at;
   for (fcm_index g = 0; g < gsize; g++)
     grid[g] = -1;
   for (fcm_index c = 0; c < b->ncells; c++) {
@@ -220,15 +216,15 @@ static fcm_status grid_cells(level0_build *b)
                   (long long)c, a, 0.5 * (double)off, d);
         bits |= (int)(off / 2) << d;
       }
-      if (c == 0) b->bits_of[a] = (unsigned char)bits;
-      FCM_CHECK(bits == b->bits_of[a], ctx, FCM_ERR_UNSUPPORTED,
+      if (c == 0) mgrid->bits_of[a] = (unsigned char)bits;
+      FCM_CHECK(bits == mgrid->bits_of[a], ctx, FCM_ERR_UNSUPPORTED,
                 "mg: cell %lld orders its nodes unlike cell 0", (long long)c);
       seen |= 1u << bits;
     }
     FCM_CHECK(seen == 0xffu, ctx, FCM_ERR_UNSUPPORTED, "mg: cell %lld is not a grid cube",
               (long long)c);
-    const fcm_index g =
-        cell_ijk[3 * c] + L->grid[0] * (cell_ijk[3 * c + 1] + L->grid[1] * cell_ijk[3 * c + 2]);
+    const fcm_index g = cell_ijk[3 * c] + mgrid->grid[0] * (cell_ijk[3 * c + 1] +
+                                                            mgrid->grid[1] * cell_ijk[3 * c + 2]);
     FCM_CHECK(grid[g] < 0, ctx, FCM_ERR_UNSUPPORTED, "mg: cells %lld and %lld overlap",
               (long long)grid[g], (long long)c);
     grid[g] = c;
@@ -426,6 +422,56 @@ cleanup:
   return st;
 }
 
+/* The mesh's grid: m's shared one (fcm__mg_grid_share()), else found (and kept by m). */
+static fcm_status mesh_grid(level0_build *b)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = b->m->ctx;
+  mg_grid *g = NULL; /* a new one, until m holds it */
+  if (!b->m->mesh_grid) {
+    FCM_ALLOC(ctx, 1, g);
+    g->refs = 1;
+    g->mesh = b->mesh;
+    FCM_TRY(ctx, grid_nodes(b, g));
+    FCM_TRY(ctx, grid_cells(b, g));
+    b->m->mesh_grid = g;
+    g = NULL;
+  }
+  const mg_grid *mg = b->m->mesh_grid;
+  for (int d = 0; d < 3; d++)
+    b->L->grid[d] = b->L0->grid[d] = mg->grid[d];
+  b->node2 = mg->node2, b->cell_ijk = mg->cell_ijk, b->grid = mg->cell_at, b->bits_of = mg->bits_of;
+cleanup:
+  fcm__mg_grid_release(ctx, &g);
+  return st;
+}
+
+void fcm__mg_grid_share(fcm_mg *m, const fcm_mg *from)
+{
+  if (m->mesh_grid || !from || !from->mesh_grid ||
+      from->mesh_grid->mesh != fcm_space_mesh(m->space) || from->oct_mesh[1])
+    return;
+  mg_grid *g = from->mesh_grid;
+#pragma omp atomic update
+  g->refs++;
+  m->mesh_grid = g;
+}
+
+void fcm__mg_grid_release(fcm_ctx *ctx, mg_grid **g)
+{
+  if (!g || !*g) return;
+  int left = 0;
+#pragma omp atomic capture
+  left = --(*g)->refs;
+  if (left == 0) {
+    fcm__free(ctx, (*g)->node2);
+    fcm__free(ctx, (*g)->cell_ijk);
+    fcm__free(ctx, (*g)->cell_at);
+    fcm__free(ctx, *g);
+  }
+  *g = NULL;
+}
+
 /* Level 0 is the space. On Hex8 it is also the first grid level: its cells are the space's
  * elements, its copies the space's copies. On Hex20 the first grid level is level 1, the
  * p-coarse Hex8 space on the same grid: the same elements (pieces) with the copies they use
@@ -452,8 +498,7 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A, const unsigned char 
   b.cells = fcm_mesh_cells(mesh);
   b.rules = fcm_space_cell_rules(m->space);
   FCM_CHECK(b.ncells > 0, ctx, FCM_ERR_ARG, "mg: the mesh has no cells");
-  FCM_TRY(ctx, grid_nodes(&b));
-  FCM_TRY(ctx, grid_cells(&b));
+  FCM_TRY(ctx, mesh_grid(&b));
   FCM_TRY(ctx, grid_copies(&b));
   FCM_TRY(ctx, grid_elements(&b));
   FCM_TRY(ctx, grid_graph(&b));
@@ -461,9 +506,6 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A, const unsigned char 
   if (b.hex20) FCM_TRY(ctx, p_level(&b));
   FCM_TRY(ctx, full_cells(&b));
 cleanup:
-  fcm__free(ctx, b.node2);
-  fcm__free(ctx, b.cell_ijk);
-  fcm__free(ctx, b.grid);
   fcm__free(ctx, b.cut);
   fcm__free(ctx, b.copy_node);
   fcm__free(ctx, b.cmap);

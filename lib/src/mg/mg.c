@@ -54,6 +54,7 @@ void fcm_mg_destroy(fcm_mg **mg)
     fcm_mesh_destroy(&m->oct_mesh[l]);
   }
   fcm__free(m->ctx, m->cut_cell);
+  fcm__mg_grid_release(m->ctx, &m->mesh_grid);
   fcm__free(m->ctx, m->blk_r);
   fcm__free(m->ctx, m->blk_dx);
   fcm__free(m->ctx, m);
@@ -328,6 +329,7 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   m->nt = fcm_ctx_num_threads(ctx);
   m->values_pending = inactive != NULL;
   m->pattern_of = fcm__mg_pattern_of(space, A);
+  if (carry) fcm__mg_grid_share(m, carry->old); /* a cut keeps the mesh */
   FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, inactive));
   if (!fcm__mg_reuse_allowed(old, m)) old = NULL;
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
