@@ -83,7 +83,7 @@ static fcm_status graph_from_edges(fcm_ctx *ctx, fcm_index ncell, fcm_index nedg
     ptr[edges[2 * e] + 1]++, ptr[edges[2 * e + 1] + 1]++;
   for (fcm_index c = 0; c < ncell; c++)
     ptr[c + 1] += ptr[c];
-  FCM_ALLOC(ctx, ptr[ncell] + 1, adj);
+  FCM_ALLOC_RAW(ctx, ptr[ncell] + 1, adj); /* every entry written below */
   for (fcm_index e = 0; e < nedge; e++) {
     const fcm_index a = edges[2 * e], b = edges[2 * e + 1];
     adj[ptr[a] + fill[a]++] = b;
@@ -318,7 +318,9 @@ static fcm_status grid_graph(level0_build *b)
   const fcm_index *links = rules ? fcm_cell_rules_links(rules) : NULL;
   const fcm_index *cell_ijk = b->cell_ijk;
   mg_level *L = b->L;
-  fcm_index *edges = NULL, nedge = 0, cap = 0;
+  /* room for a neighbour along each axis of every element: grown only where cells are split */
+  fcm_index *edges = NULL, nedge = 0, cap = 3 * L->ncell + 64;
+  FCM_ALLOC_RAW(ctx, 2 * cap, edges); /* read up to nedge, written below */
   for (fcm_index e = 0; e < L->ncell; e++) {
     const fcm_index c = fcm_space_element_cell(sp, e);
     for (int d = 0; d < 3; d++) {
@@ -625,26 +627,37 @@ static fcm_status coarse_copies(fcm_ctx *ctx, const mg_level *F, mg_level *C, co
   for (fcm_index k = 0; k < F->ncopy; k++) {
     if (cptr[k + 1] - cptr[k] < 2) continue;
     const fcm_index c0 = cusers[cptr[k]];
-    /* the coarse nodes with nonzero weight: corner bits of c0 */
+    const fcm_index *pk = F->copy_ijk + 3 * k, *q0 = C->ijk + 3 * c0;
+    /* the coarse nodes with nonzero weight: the corner bits of c0 within one fine cell of
+     * the copy along every axis (bit 0: node 2 q0, bit 1: node 2 q0 + 2) */
+    int along[3];
+    for (int d = 0; d < 3; d++) {
+      const fcm_index off = pk[d] - 2 * q0[d];
+      along[d] = (off >= -1 && off <= 1 ? 1 : 0) | (off >= 1 && off <= 3 ? 2 : 0);
+    }
     for (int b = 0; b < 8; b++) {
-      int ok = 1;
-      for (int d = 0; d < 3 && ok; d++) {
-        const fcm_index p = F->copy_ijk[3 * k + d], q = 2 * (C->ijk[3 * c0 + d] + (b >> d & 1));
-        ok = p == q || p == q - 1 || p == q + 1;
-      }
-      if (!ok) continue;
+      if (!(along[0] >> (b & 1) & 1) || !(along[1] >> (b >> 1 & 1) & 1) ||
+          !(along[2] >> (b >> 2 & 1) & 1))
+        continue;
+      /* the same node as a corner of every other user: its slots joined to c0's, the set's
+       * root (its smallest slot, as uf_union() links) found once */
+      fcm_index r0 = uf_find(uf, 8 * c0 + b);
       for (fcm_index i = cptr[k] + 1; i < cptr[k + 1]; i++) {
         const fcm_index c1 = cusers[i];
-        /* the same node as a corner of c1 */
         int b1 = 0;
         for (int d = 0; d < 3; d++) {
-          const fcm_index q = C->ijk[3 * c0 + d] + (b >> d & 1), off = q - C->ijk[3 * c1 + d];
+          const fcm_index off = q0[d] + (b >> d & 1) - C->ijk[3 * c1 + d];
           FCM_CHECK(off == 0 || off == 1, ctx, FCM_ERR_INTERNAL,
                     "mg: copy %lld used by coarse cells %lld and %lld that share no node",
                     (long long)k, (long long)c0, (long long)c1);
           b1 |= (int)off << d;
         }
-        uf_union(uf, 8 * c0 + b, 8 * c1 + b1);
+        const fcm_index s1 = 8 * c1 + b1;
+        if (s1 == r0 || uf[s1] == r0) continue; /* joined already (r0 is a root) */
+        const fcm_index r1 = uf_find(uf, s1);
+        if (r1 == r0) continue;
+        uf[FCM_MAX(r0, r1)] = FCM_MIN(r0, r1);
+        r0 = FCM_MIN(r0, r1);
       }
     }
   }

@@ -76,7 +76,7 @@ typedef struct mg_level {
   const fcm_csr *A;        /* level 0: borrowed */
   fcm_csr *Aown;           /* levels >= 1 */
   fcm_index *diag;         /* position of a_ii */
-  fcm_index *tpos;         /* levels >= 1: per stored entry (i, j) with j > i, the position of
+  int *tpos;               /* levels >= 1: per stored entry (i, j) with j > i, the position of
                               (j, i), for the symmetrization of every Galerkin product */
   double *dinv;            /* 1 / a_ii */
   /* prolongation from level l+1 (n x n_coarse) */

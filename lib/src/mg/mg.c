@@ -15,6 +15,7 @@
  * lib/docs/multigrid_threads.md. */
 #include "mg/levels_impl.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -205,6 +206,9 @@ static fcm_status galerkin_pattern(fcm_mg *m, int l, mg_carry *carry)
      * row j along. */
     const fcm_index *cp = fcm_csr_row_ptr(C->Aown);
     const int *cc = fcm_csr_col_idx(C->Aown);
+    FCM_CHECK(cp[C->n] <= INT_MAX, ctx, FCM_ERR_UNSUPPORTED,
+              "mg: level %d: %lld entries do not fit the transposed positions' 32-bit range", l + 1,
+              (long long)cp[C->n]);
     FCM_ALLOC_RAW(ctx, cp[C->n] + 1, C->tpos); /* every entry written below */
     FCM_ALLOC_RAW(ctx, C->n + 1, next);
     memcpy(next, cp, sizeof *next * (size_t)C->n);
@@ -218,7 +222,7 @@ static fcm_status galerkin_pattern(fcm_mg *m, int l, mg_carry *carry)
         FCM_CHECK(next[j] < cp[j + 1] && cc[next[j]] == i, ctx, FCM_ERR_INTERNAL,
                   "mg: level %d: the Galerkin pattern has (%lld, %lld) but not its transpose",
                   l + 1, (long long)i, (long long)j);
-        C->tpos[p] = next[j]++;
+        C->tpos[p] = (int)next[j]++;
       }
   }
 cleanup:
