@@ -384,11 +384,16 @@ fcm_status fcm__ptap_add_diagonal(fcm_ctx *ctx, fcm_index n, fcm_index **ptr, in
   fcm_index *p = *ptr, *np = NULL;
   int *c = *col, *nc = NULL;
   fcm_index missing = 0;
-  for (fcm_index i = 0; i < n; i++) {
-    int has = 0;
-    for (fcm_index q = p[i]; q < p[i + 1] && !has; q++)
-      has = c[q] == i;
-    missing += !has;
+  for (fcm_index i = 0; i < n; i++) { /* rows sorted: the diagonal by bisection */
+    fcm_index lo = p[i], hi = p[i + 1];
+    while (lo < hi) {
+      const fcm_index mid = lo + (hi - lo) / 2;
+      if (c[mid] < i)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    missing += !(lo < p[i + 1] && c[lo] == i);
   }
   if (missing == 0) goto cleanup;
   FCM_ALLOC(ctx, n + 1, np);
