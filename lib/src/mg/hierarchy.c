@@ -243,7 +243,7 @@ static fcm_status grid_copies(level0_build *b)
   const fcm_index nk = b->nk;
   L->ncell = fcm_space_num_elements(sp);
   FCM_ALLOC(ctx, nk + 1, b->copy_node);
-  FCM_ALLOC(ctx, nk + 1, b->cmap);
+  FCM_ALLOC_RAW(ctx, nk + 1, b->cmap); /* every entry written below */
   fcm_index *copy_node = b->copy_node, *cmap = b->cmap;
   for (fcm_index nd = 0; nd < b->nnode; nd++) {
     const fcm_index k0 = fcm_space_node_dof(sp, nd), nc = fcm_space_node_copies(sp, nd);
@@ -278,9 +278,9 @@ static fcm_status grid_elements(level0_build *b)
   fcm_ctx *ctx = b->m->ctx;
   const fcm_space *sp = b->sp;
   mg_level *L = b->L;
-  FCM_ALLOC(ctx, 3 * L->ncell + 1, L->ijk);
-  FCM_ALLOC(ctx, 8 * L->ncell + 1, L->corner);
-  FCM_ALLOC(ctx, 8 * L->ncell + 1, L->own);
+  FCM_ALLOC_RAW(ctx, 3 * L->ncell + 1, L->ijk); /* every entry written below (8 corner bits) */
+  FCM_ALLOC_RAW(ctx, 8 * L->ncell + 1, L->corner);
+  FCM_ALLOC_RAW(ctx, 8 * L->ncell + 1, L->own);
   FCM_ALLOC(ctx, b->ncells + 1, b->cut);
   for (fcm_index e = 0; e < L->ncell; e++) {
     const fcm_index c = fcm_space_element_cell(sp, e);
@@ -374,8 +374,8 @@ static fcm_status level0_dofs(level0_build *b, const fcm_csr *A, const unsigned 
   L0->n = 3 * b->nk;
   L0->ncopy = b->nk;
   L0->ncell = b->L->ncell;
-  FCM_ALLOC(ctx, L0->n + 1, L0->dof);
-  FCM_ALLOC(ctx, L0->n + 1, L0->inactive);
+  FCM_ALLOC_RAW(ctx, L0->n + 1, L0->dof); /* every entry written below */
+  FCM_ALLOC_RAW(ctx, L0->n + 1, L0->inactive);
   for (fcm_index i = 0; i < L0->n; i++)
     L0->dof[i] = i;
   if (inactive0)
@@ -525,8 +525,8 @@ static fcm_status coarse_cells(fcm_ctx *ctx, const mg_level *F, mg_level *C, fcm
   const fcm_index nf = F->ncell;
   for (int d = 0; d < 3; d++)
     C->grid[d] = (F->grid[d] + 1) / 2;
-  FCM_ALLOC(ctx, nf + 1, uf);
-  FCM_ALLOC(ctx, nf + 1, cid);
+  FCM_ALLOC_RAW(ctx, nf + 1, uf); /* every entry written below */
+  FCM_ALLOC_RAW(ctx, nf + 1, cid);
   for (fcm_index c = 0; c < nf; c++)
     uf[c] = c;
   for (fcm_index c = 0; c < nf; c++)
@@ -597,7 +597,7 @@ static fcm_status copy_users(fcm_ctx *ctx, const mg_level *F, const fcm_index *c
       if (F->own[8 * c + b]) cptr[F->corner[8 * c + b] + 1]++;
   for (fcm_index k = 0; k < nk; k++)
     cptr[k + 1] += cptr[k];
-  FCM_ALLOC(ctx, cptr[nk] + 1, cusers);
+  FCM_ALLOC_RAW(ctx, cptr[nk] + 1, cusers); /* every entry written below */
   for (fcm_index c = 0; c < nf; c++)
     for (int b = 0; b < 8; b++)
       if (F->own[8 * c + b]) {
@@ -621,7 +621,7 @@ static fcm_status coarse_copies(fcm_ctx *ctx, const mg_level *F, mg_level *C, co
   fcm_status st = FCM_OK;
   fcm_index *uf = NULL;
   const fcm_index nc = C->ncell;
-  FCM_ALLOC(ctx, 8 * nc + 1, uf);
+  FCM_ALLOC_RAW(ctx, 8 * nc + 1, uf); /* every entry written below */
   for (fcm_index s = 0; s < 8 * nc; s++)
     uf[s] = s;
   for (fcm_index k = 0; k < F->ncopy; k++) {
@@ -705,8 +705,8 @@ static fcm_status coarse_dofs(fcm_ctx *ctx, const mg_level *F, mg_level *C,
         anc_in[3 * K + c] += F->inactive[3 * k + c];
     }
   C->n = 3 * ncopy;
-  FCM_ALLOC(ctx, C->n + 1, C->dof);
-  FCM_ALLOC(ctx, C->n + 1, C->inactive);
+  FCM_ALLOC_RAW(ctx, C->n + 1, C->dof); /* every entry written below */
+  FCM_ALLOC_RAW(ctx, C->n + 1, C->inactive);
   for (fcm_index K = 0; K < ncopy; K++)
     for (int c = 0; c < 3; c++) {
       C->dof[3 * K + c] = 3 * K + c;
