@@ -55,6 +55,19 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
     fcm_mg *plain = NULL;
     TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, p->space, *pattern, inactive, o, &plain));
     TEST_TRUE(plain->nlev == prep->nlev);
+    /* the mesh grid: the old hierarchy's shared (one mesh), the one a creation finds */
+    const mg_grid *g = prep->mesh_grid, *h = plain->mesh_grid;
+    TEST_TRUE(g && h && g != h && h->refs == 1 && g->mesh == h->mesh);
+    TEST_TRUE(old ? g == old->mesh_grid && g->refs >= 2 : g->refs == 1);
+    if (g && h) {
+      const fcm_index nn = fcm_mesh_num_nodes(h->mesh), nc = fcm_mesh_num_cells(h->mesh);
+      TEST_TRUE(memcmp(g->grid, h->grid, sizeof g->grid) == 0 &&
+                memcmp(g->bits_of, h->bits_of, sizeof g->bits_of) == 0 &&
+                memcmp(g->node2, h->node2, sizeof *g->node2 * 3 * (size_t)nn) == 0 &&
+                memcmp(g->cell_ijk, h->cell_ijk, sizeof *g->cell_ijk * 3 * (size_t)nc) == 0 &&
+                memcmp(g->cell_at, h->cell_at,
+                       sizeof *g->cell_at * (size_t)(h->grid[0] * h->grid[1] * h->grid[2])) == 0);
+    }
     for (int l = 0; l + 1 < prep->nlev && l + 1 < plain->nlev; l++)
       TEST_TRUE(fcm__schwarz_same_positions(prep->lev[l].blk, plain->lev[l].blk));
     size_t np = 0;

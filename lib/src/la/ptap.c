@@ -44,7 +44,25 @@ void fcm__ptap_sort_ints(int *a, fcm_index n)
   }
 }
 
-/* R = P^T: row J of R lists the rows i of P with a column J, ascending. */
+/* Are P's rows node-structured: rows 3 k + 1 and 3 k + 2 row 3 k's columns (each 3 K) + 1
+ * and + 2, n and nc multiples of 3? */
+static int p_by_nodes(fcm_index n, fcm_index nc, const fcm_index *P_ptr, const int *P_col)
+{
+  if (n % 3 != 0 || nc % 3 != 0) return 0;
+  for (fcm_index k = 0; k < n / 3; k++) {
+    const fcm_index p0 = P_ptr[3 * k], len = P_ptr[3 * k + 1] - p0;
+    if (P_ptr[3 * k + 2] - P_ptr[3 * k + 1] != len || P_ptr[3 * k + 3] - P_ptr[3 * k + 2] != len)
+      return 0;
+    const int *c0 = P_col + p0, *c1 = c0 + len, *c2 = c1 + len;
+    for (fcm_index q = 0; q < len; q++)
+      if (c0[q] % 3 != 0 || c1[q] != c0[q] + 1 || c2[q] != c0[q] + 2) return 0;
+  }
+  return 1;
+}
+
+/* R = P^T: row J of R lists the rows i of P with a column J, ascending. Node-structured P
+ * (p_by_nodes()): rows 3 K + c of R are the rows 3 k + c of the k with a column 3 K, so each
+ * node's three rows are placed together. */
 fcm_status fcm__ptap_transpose_pattern(fcm_ctx *ctx, fcm_index n, fcm_index nc,
                                        const fcm_index *P_ptr, const int *P_col,
                                        const double *P_val, fcm_index **R_ptr, int **R_col,
@@ -58,16 +76,38 @@ fcm_status fcm__ptap_transpose_pattern(fcm_ctx *ctx, fcm_index n, fcm_index nc,
   FCM_ALLOC_RAW(ctx, nnz + 1, *R_val);
   FCM_ALLOC(ctx, nc + 1, fill);
   fcm_index *rp = *R_ptr;
-  for (fcm_index p = 0; p < nnz; p++)
-    rp[P_col[p] + 1]++;
-  for (fcm_index J = 0; J < nc; J++)
-    rp[J + 1] += rp[J];
-  for (fcm_index i = 0; i < n; i++)
-    for (fcm_index p = P_ptr[i]; p < P_ptr[i + 1]; p++) {
-      const fcm_index J = P_col[p];
-      (*R_col)[rp[J] + fill[J]] = (int)i;
-      (*R_val)[rp[J] + fill[J]++] = P_val[p];
+  int *rc = *R_col;
+  double *rv = *R_val;
+  if (p_by_nodes(n, nc, P_ptr, P_col)) {
+    for (fcm_index k = 0; k < n / 3; k++)
+      for (fcm_index p = P_ptr[3 * k]; p < P_ptr[3 * k + 1]; p++)
+        rp[P_col[p] + 1]++;
+    for (fcm_index K = 0; K < nc; K += 3)
+      rp[K + 2] = rp[K + 3] = rp[K + 1];
+    for (fcm_index J = 0; J < nc; J++)
+      rp[J + 1] += rp[J];
+    for (fcm_index k = 0; k < n / 3; k++) {
+      const fcm_index p0 = P_ptr[3 * k], len = P_ptr[3 * k + 1] - p0;
+      for (fcm_index q = 0; q < len; q++) {
+        const fcm_index J = P_col[p0 + q], f = fill[J / 3]++;
+        for (int c = 0; c < 3; c++) {
+          rc[rp[J + c] + f] = (int)(3 * k + c);
+          rv[rp[J + c] + f] = P_val[p0 + c * len + q];
+        }
+      }
     }
+  } else {
+    for (fcm_index p = 0; p < nnz; p++)
+      rp[P_col[p] + 1]++;
+    for (fcm_index J = 0; J < nc; J++)
+      rp[J + 1] += rp[J];
+    for (fcm_index i = 0; i < n; i++)
+      for (fcm_index p = P_ptr[i]; p < P_ptr[i + 1]; p++) {
+        const fcm_index J = P_col[p];
+        rc[rp[J] + fill[J]] = (int)i;
+        rv[rp[J] + fill[J]++] = P_val[p];
+      }
+  }
 cleanup:
   fcm__free(ctx, fill);
   return st;
@@ -344,11 +384,16 @@ fcm_status fcm__ptap_add_diagonal(fcm_ctx *ctx, fcm_index n, fcm_index **ptr, in
   fcm_index *p = *ptr, *np = NULL;
   int *c = *col, *nc = NULL;
   fcm_index missing = 0;
-  for (fcm_index i = 0; i < n; i++) {
-    int has = 0;
-    for (fcm_index q = p[i]; q < p[i + 1] && !has; q++)
-      has = c[q] == i;
-    missing += !has;
+  for (fcm_index i = 0; i < n; i++) { /* rows sorted: the diagonal by bisection */
+    fcm_index lo = p[i], hi = p[i + 1];
+    while (lo < hi) {
+      const fcm_index mid = lo + (hi - lo) / 2;
+      if (c[mid] < i)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    missing += !(lo < p[i + 1] && c[lo] == i);
   }
   if (missing == 0) goto cleanup;
   FCM_ALLOC(ctx, n + 1, np);

@@ -97,8 +97,8 @@ static fcm_status coarse_map(fcm_mg *m, mg_carry *c, int l)
   const mg_level *O = &c->old->lev[l], *L = &m->lev[l];
   const fcm_index no = c->old->lev[l + 1].n, nn = m->lev[l + 1].n;
   fcm_index *cand = NULL, *back = NULL;
-  FCM_ALLOC(ctx, no + 1, cand);
-  FCM_ALLOC(ctx, nn + 1, back);
+  FCM_ALLOC_RAW(ctx, no + 1, cand); /* every entry written below */
+  FCM_ALLOC_RAW(ctx, nn + 1, back);
   for (fcm_index o = 0; o < no; o++)
     cand[o] = -1;
   for (fcm_index i = 0; i < nn; i++)

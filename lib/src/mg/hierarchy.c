@@ -83,7 +83,7 @@ static fcm_status graph_from_edges(fcm_ctx *ctx, fcm_index ncell, fcm_index nedg
     ptr[edges[2 * e] + 1]++, ptr[edges[2 * e + 1] + 1]++;
   for (fcm_index c = 0; c < ncell; c++)
     ptr[c + 1] += ptr[c];
-  FCM_ALLOC(ctx, ptr[ncell] + 1, adj);
+  FCM_ALLOC_RAW(ctx, ptr[ncell] + 1, adj); /* every entry written below */
   for (fcm_index e = 0; e < nedge; e++) {
     const fcm_index a = edges[2 * e], b = edges[2 * e + 1];
     adj[ptr[a] + fill[a]++] = b;
@@ -140,22 +140,21 @@ typedef struct level0_build {
   fcm_index nnode, ncells, nk;
   const fcm_index *cells;
   const fcm_cell_rules *rules;
-  fcm_index *node2;         /* 3 per mesh node: position on the half grid */
-  fcm_index *cell_ijk;      /* 3 per mesh cell: grid position */
-  fcm_index *grid;          /* per grid position: the mesh cell there, -1: none */
-  unsigned char bits_of[8]; /* corner bits of each local corner node */
-  fcm_index *copy_node;     /* per space copy: its node */
-  fcm_index *cmap;          /* space copy -> grid level copy (-1: none; identity on Hex8) */
-  unsigned char *cut;       /* per mesh cell: cut or split */
+  const fcm_index *node2;       /* the mesh grid's (mg_grid) */
+  const fcm_index *cell_ijk;    /* the mesh grid's */
+  const fcm_index *grid;        /* the mesh grid's cell_at */
+  const unsigned char *bits_of; /* the mesh grid's */
+  fcm_index *copy_node;         /* per space copy: its node */
+  fcm_index *cmap;              /* space copy -> grid level copy (-1: none; identity on Hex8) */
+  unsigned char *cut;           /* per mesh cell: cut or split */
 } level0_build;
 
 /* Grid spacing from cell 0, origin from the bounding box; node positions on the half grid:
  * corners at even, mid-edge nodes at odd coordinates. */
-static fcm_status grid_nodes(level0_build *b)
+static fcm_status grid_nodes(level0_build *b, mg_grid *mgrid)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = b->m->ctx;
-  mg_level *L = b->L;
   const double *X = fcm_mesh_coords(b->mesh);
   double lo[3], hi[3], h[3];
   fcm_mesh_bounding_box(b->mesh, lo, hi);
@@ -167,20 +166,18 @@ static fcm_status grid_nodes(level0_build *b)
     }
     h[d] = mx - mn;
     FCM_CHECK(h[d] > 0.0, ctx, FCM_ERR_UNSUPPORTED, "mg: cell 0 has no extent along axis %d", d);
-    L->grid[d] = (fcm_index)llround((hi[d] - lo[d]) / h[d]);
+    mgrid->grid[d] = (fcm_index)llround((hi[d] - lo[d]) / h[d]);
   }
-  if (b->hex20)
-    b->L0->grid[0] = L->grid[0], b->L0->grid[1] = L->grid[1], b->L0->grid[2] = L->grid[2];
-  FCM_ALLOC(ctx, 3 * b->nnode + 1, b->node2);
+  FCM_ALLOC_RAW(ctx, 3 * b->nnode + 1, mgrid->node2); /* every entry written below */
   for (fcm_index n = 0; n < b->nnode; n++)
     for (int d = 0; d < 3; d++) {
       const double t = 2.0 * (X[3 * n + d] - lo[d]) / h[d];
       const fcm_index r = (fcm_index)llround(t);
-      FCM_CHECK(fabs(t - (double)r) < 2e-6 && r >= 0 && r <= 2 * L->grid[d], ctx,
+      FCM_CHECK(fabs(t - (double)r) < 2e-6 && r >= 0 && r <= 2 * mgrid->grid[d], ctx,
                 FCM_ERR_UNSUPPORTED,
                 "mg: node %lld is not on the grid of spacing %g along axis %d (not a box grid)",
                 (long long)n, h[d], d);
-      b->node2[3 * n + d] = r;
+      mgrid->node2[3 * n + d] = r;
     }
 cleanup:
   return st;
@@ -188,16 +185,15 @@ cleanup:
 
 /* Cell positions, the cell at each grid position and the corner bits of each local corner
  * node; every cell a grid cube with its nodes in cell 0's order, no two overlapping. */
-static fcm_status grid_cells(level0_build *b)
+static fcm_status grid_cells(level0_build *b, mg_grid *mgrid)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = b->m->ctx;
-  const mg_level *L = b->L;
-  const fcm_index *node2 = b->node2;
-  FCM_ALLOC(ctx, 3 * b->ncells + 1, b->cell_ijk);
-  const fcm_index gsize = L->grid[0] * L->grid[1] * L->grid[2];
-  FCM_ALLOC(ctx, gsize + 1, b->grid);
-  fcm_index *cell_ijk = b->cell_ijk, *grid = b->grid;
+  const fcm_index *node2 = mgrid->node2;
+  FCM_ALLOC_RAW(ctx, 3 * b->ncells + 1, mgrid->cell_ijk); /* every entry written below */
+  const fcm_index gsize = mgrid->grid[0] * mgrid->grid[1] * mgrid->grid[2];
+  FCM_ALLOC_RAW(ctx, gsize + 1, mgrid->cell_at);
+  fcm_index *cell_ijk = mgrid->cell_ijk, *grid = mgrid->cell_at;
   for (fcm_index g = 0; g < gsize; g++)
     grid[g] = -1;
   for (fcm_index c = 0; c < b->ncells; c++) {
@@ -220,15 +216,15 @@ static fcm_status grid_cells(level0_build *b)
                   (long long)c, a, 0.5 * (double)off, d);
         bits |= (int)(off / 2) << d;
       }
-      if (c == 0) b->bits_of[a] = (unsigned char)bits;
-      FCM_CHECK(bits == b->bits_of[a], ctx, FCM_ERR_UNSUPPORTED,
+      if (c == 0) mgrid->bits_of[a] = (unsigned char)bits;
+      FCM_CHECK(bits == mgrid->bits_of[a], ctx, FCM_ERR_UNSUPPORTED,
                 "mg: cell %lld orders its nodes unlike cell 0", (long long)c);
       seen |= 1u << bits;
     }
     FCM_CHECK(seen == 0xffu, ctx, FCM_ERR_UNSUPPORTED, "mg: cell %lld is not a grid cube",
               (long long)c);
-    const fcm_index g =
-        cell_ijk[3 * c] + L->grid[0] * (cell_ijk[3 * c + 1] + L->grid[1] * cell_ijk[3 * c + 2]);
+    const fcm_index g = cell_ijk[3 * c] + mgrid->grid[0] * (cell_ijk[3 * c + 1] +
+                                                            mgrid->grid[1] * cell_ijk[3 * c + 2]);
     FCM_CHECK(grid[g] < 0, ctx, FCM_ERR_UNSUPPORTED, "mg: cells %lld and %lld overlap",
               (long long)grid[g], (long long)c);
     grid[g] = c;
@@ -247,7 +243,7 @@ static fcm_status grid_copies(level0_build *b)
   const fcm_index nk = b->nk;
   L->ncell = fcm_space_num_elements(sp);
   FCM_ALLOC(ctx, nk + 1, b->copy_node);
-  FCM_ALLOC(ctx, nk + 1, b->cmap);
+  FCM_ALLOC_RAW(ctx, nk + 1, b->cmap); /* every entry written below */
   fcm_index *copy_node = b->copy_node, *cmap = b->cmap;
   for (fcm_index nd = 0; nd < b->nnode; nd++) {
     const fcm_index k0 = fcm_space_node_dof(sp, nd), nc = fcm_space_node_copies(sp, nd);
@@ -282,9 +278,9 @@ static fcm_status grid_elements(level0_build *b)
   fcm_ctx *ctx = b->m->ctx;
   const fcm_space *sp = b->sp;
   mg_level *L = b->L;
-  FCM_ALLOC(ctx, 3 * L->ncell + 1, L->ijk);
-  FCM_ALLOC(ctx, 8 * L->ncell + 1, L->corner);
-  FCM_ALLOC(ctx, 8 * L->ncell + 1, L->own);
+  FCM_ALLOC_RAW(ctx, 3 * L->ncell + 1, L->ijk); /* every entry written below (8 corner bits) */
+  FCM_ALLOC_RAW(ctx, 8 * L->ncell + 1, L->corner);
+  FCM_ALLOC_RAW(ctx, 8 * L->ncell + 1, L->own);
   FCM_ALLOC(ctx, b->ncells + 1, b->cut);
   for (fcm_index e = 0; e < L->ncell; e++) {
     const fcm_index c = fcm_space_element_cell(sp, e);
@@ -322,7 +318,9 @@ static fcm_status grid_graph(level0_build *b)
   const fcm_index *links = rules ? fcm_cell_rules_links(rules) : NULL;
   const fcm_index *cell_ijk = b->cell_ijk;
   mg_level *L = b->L;
-  fcm_index *edges = NULL, nedge = 0, cap = 0;
+  /* room for a neighbour along each axis of every element: grown only where cells are split */
+  fcm_index *edges = NULL, nedge = 0, cap = 3 * L->ncell + 64;
+  FCM_ALLOC_RAW(ctx, 2 * cap, edges); /* read up to nedge, written below */
   for (fcm_index e = 0; e < L->ncell; e++) {
     const fcm_index c = fcm_space_element_cell(sp, e);
     for (int d = 0; d < 3; d++) {
@@ -376,8 +374,8 @@ static fcm_status level0_dofs(level0_build *b, const fcm_csr *A, const unsigned 
   L0->n = 3 * b->nk;
   L0->ncopy = b->nk;
   L0->ncell = b->L->ncell;
-  FCM_ALLOC(ctx, L0->n + 1, L0->dof);
-  FCM_ALLOC(ctx, L0->n + 1, L0->inactive);
+  FCM_ALLOC_RAW(ctx, L0->n + 1, L0->dof); /* every entry written below */
+  FCM_ALLOC_RAW(ctx, L0->n + 1, L0->inactive);
   for (fcm_index i = 0; i < L0->n; i++)
     L0->dof[i] = i;
   if (inactive0)
@@ -426,6 +424,56 @@ cleanup:
   return st;
 }
 
+/* The mesh's grid: m's shared one (fcm__mg_grid_share()), else found (and kept by m). */
+static fcm_status mesh_grid(level0_build *b)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = b->m->ctx;
+  mg_grid *g = NULL; /* a new one, until m holds it */
+  if (!b->m->mesh_grid) {
+    FCM_ALLOC(ctx, 1, g);
+    g->refs = 1;
+    g->mesh = b->mesh;
+    FCM_TRY(ctx, grid_nodes(b, g));
+    FCM_TRY(ctx, grid_cells(b, g));
+    b->m->mesh_grid = g;
+    g = NULL;
+  }
+  const mg_grid *mg = b->m->mesh_grid;
+  for (int d = 0; d < 3; d++)
+    b->L->grid[d] = b->L0->grid[d] = mg->grid[d];
+  b->node2 = mg->node2, b->cell_ijk = mg->cell_ijk, b->grid = mg->cell_at, b->bits_of = mg->bits_of;
+cleanup:
+  fcm__mg_grid_release(ctx, &g);
+  return st;
+}
+
+void fcm__mg_grid_share(fcm_mg *m, const fcm_mg *from)
+{
+  if (m->mesh_grid || !from || !from->mesh_grid ||
+      from->mesh_grid->mesh != fcm_space_mesh(m->space) || from->oct_mesh[1])
+    return;
+  mg_grid *g = from->mesh_grid;
+#pragma omp atomic update
+  g->refs++;
+  m->mesh_grid = g;
+}
+
+void fcm__mg_grid_release(fcm_ctx *ctx, mg_grid **g)
+{
+  if (!g || !*g) return;
+  int left = 0;
+#pragma omp atomic capture
+  left = --(*g)->refs;
+  if (left == 0) {
+    fcm__free(ctx, (*g)->node2);
+    fcm__free(ctx, (*g)->cell_ijk);
+    fcm__free(ctx, (*g)->cell_at);
+    fcm__free(ctx, *g);
+  }
+  *g = NULL;
+}
+
 /* Level 0 is the space. On Hex8 it is also the first grid level: its cells are the space's
  * elements, its copies the space's copies. On Hex20 the first grid level is level 1, the
  * p-coarse Hex8 space on the same grid: the same elements (pieces) with the copies they use
@@ -452,8 +500,7 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A, const unsigned char 
   b.cells = fcm_mesh_cells(mesh);
   b.rules = fcm_space_cell_rules(m->space);
   FCM_CHECK(b.ncells > 0, ctx, FCM_ERR_ARG, "mg: the mesh has no cells");
-  FCM_TRY(ctx, grid_nodes(&b));
-  FCM_TRY(ctx, grid_cells(&b));
+  FCM_TRY(ctx, mesh_grid(&b));
   FCM_TRY(ctx, grid_copies(&b));
   FCM_TRY(ctx, grid_elements(&b));
   FCM_TRY(ctx, grid_graph(&b));
@@ -461,9 +508,6 @@ static fcm_status build_level0(fcm_mg *m, const fcm_csr *A, const unsigned char 
   if (b.hex20) FCM_TRY(ctx, p_level(&b));
   FCM_TRY(ctx, full_cells(&b));
 cleanup:
-  fcm__free(ctx, b.node2);
-  fcm__free(ctx, b.cell_ijk);
-  fcm__free(ctx, b.grid);
   fcm__free(ctx, b.cut);
   fcm__free(ctx, b.copy_node);
   fcm__free(ctx, b.cmap);
@@ -481,8 +525,8 @@ static fcm_status coarse_cells(fcm_ctx *ctx, const mg_level *F, mg_level *C, fcm
   const fcm_index nf = F->ncell;
   for (int d = 0; d < 3; d++)
     C->grid[d] = (F->grid[d] + 1) / 2;
-  FCM_ALLOC(ctx, nf + 1, uf);
-  FCM_ALLOC(ctx, nf + 1, cid);
+  FCM_ALLOC_RAW(ctx, nf + 1, uf); /* every entry written below */
+  FCM_ALLOC_RAW(ctx, nf + 1, cid);
   for (fcm_index c = 0; c < nf; c++)
     uf[c] = c;
   for (fcm_index c = 0; c < nf; c++)
@@ -553,7 +597,7 @@ static fcm_status copy_users(fcm_ctx *ctx, const mg_level *F, const fcm_index *c
       if (F->own[8 * c + b]) cptr[F->corner[8 * c + b] + 1]++;
   for (fcm_index k = 0; k < nk; k++)
     cptr[k + 1] += cptr[k];
-  FCM_ALLOC(ctx, cptr[nk] + 1, cusers);
+  FCM_ALLOC_RAW(ctx, cptr[nk] + 1, cusers); /* every entry written below */
   for (fcm_index c = 0; c < nf; c++)
     for (int b = 0; b < 8; b++)
       if (F->own[8 * c + b]) {
@@ -577,32 +621,43 @@ static fcm_status coarse_copies(fcm_ctx *ctx, const mg_level *F, mg_level *C, co
   fcm_status st = FCM_OK;
   fcm_index *uf = NULL;
   const fcm_index nc = C->ncell;
-  FCM_ALLOC(ctx, 8 * nc + 1, uf);
+  FCM_ALLOC_RAW(ctx, 8 * nc + 1, uf); /* every entry written below */
   for (fcm_index s = 0; s < 8 * nc; s++)
     uf[s] = s;
   for (fcm_index k = 0; k < F->ncopy; k++) {
     if (cptr[k + 1] - cptr[k] < 2) continue;
     const fcm_index c0 = cusers[cptr[k]];
-    /* the coarse nodes with nonzero weight: corner bits of c0 */
+    const fcm_index *pk = F->copy_ijk + 3 * k, *q0 = C->ijk + 3 * c0;
+    /* the coarse nodes with nonzero weight: the corner bits of c0 within one fine cell of
+     * the copy along every axis (bit 0: node 2 q0, bit 1: node 2 q0 + 2) */
+    int along[3];
+    for (int d = 0; d < 3; d++) {
+      const fcm_index off = pk[d] - 2 * q0[d];
+      along[d] = (off >= -1 && off <= 1 ? 1 : 0) | (off >= 1 && off <= 3 ? 2 : 0);
+    }
     for (int b = 0; b < 8; b++) {
-      int ok = 1;
-      for (int d = 0; d < 3 && ok; d++) {
-        const fcm_index p = F->copy_ijk[3 * k + d], q = 2 * (C->ijk[3 * c0 + d] + (b >> d & 1));
-        ok = p == q || p == q - 1 || p == q + 1;
-      }
-      if (!ok) continue;
+      if (!(along[0] >> (b & 1) & 1) || !(along[1] >> (b >> 1 & 1) & 1) ||
+          !(along[2] >> (b >> 2 & 1) & 1))
+        continue;
+      /* the same node as a corner of every other user: its slots joined to c0's, the set's
+       * root (its smallest slot, as uf_union() links) found once */
+      fcm_index r0 = uf_find(uf, 8 * c0 + b);
       for (fcm_index i = cptr[k] + 1; i < cptr[k + 1]; i++) {
         const fcm_index c1 = cusers[i];
-        /* the same node as a corner of c1 */
         int b1 = 0;
         for (int d = 0; d < 3; d++) {
-          const fcm_index q = C->ijk[3 * c0 + d] + (b >> d & 1), off = q - C->ijk[3 * c1 + d];
+          const fcm_index off = q0[d] + (b >> d & 1) - C->ijk[3 * c1 + d];
           FCM_CHECK(off == 0 || off == 1, ctx, FCM_ERR_INTERNAL,
                     "mg: copy %lld used by coarse cells %lld and %lld that share no node",
                     (long long)k, (long long)c0, (long long)c1);
           b1 |= (int)off << d;
         }
-        uf_union(uf, 8 * c0 + b, 8 * c1 + b1);
+        const fcm_index s1 = 8 * c1 + b1;
+        if (s1 == r0 || uf[s1] == r0) continue; /* joined already (r0 is a root) */
+        const fcm_index r1 = uf_find(uf, s1);
+        if (r1 == r0) continue;
+        uf[FCM_MAX(r0, r1)] = FCM_MIN(r0, r1);
+        r0 = FCM_MIN(r0, r1);
       }
     }
   }
@@ -650,8 +705,8 @@ static fcm_status coarse_dofs(fcm_ctx *ctx, const mg_level *F, mg_level *C,
         anc_in[3 * K + c] += F->inactive[3 * k + c];
     }
   C->n = 3 * ncopy;
-  FCM_ALLOC(ctx, C->n + 1, C->dof);
-  FCM_ALLOC(ctx, C->n + 1, C->inactive);
+  FCM_ALLOC_RAW(ctx, C->n + 1, C->dof); /* every entry written below */
+  FCM_ALLOC_RAW(ctx, C->n + 1, C->inactive);
   for (fcm_index K = 0; K < ncopy; K++)
     for (int c = 0; c < 3; c++) {
       C->dof[3 * K + c] = 3 * K + c;

@@ -76,7 +76,7 @@ typedef struct mg_level {
   const fcm_csr *A;        /* level 0: borrowed */
   fcm_csr *Aown;           /* levels >= 1 */
   fcm_index *diag;         /* position of a_ii */
-  fcm_index *tpos;         /* levels >= 1: per stored entry (i, j) with j > i, the position of
+  int *tpos;               /* levels >= 1: per stored entry (i, j) with j > i, the position of
                               (j, i), for the symmetrization of every Galerkin product */
   double *dinv;            /* 1 / a_ii */
   /* prolongation from level l+1 (n x n_coarse) */
@@ -102,6 +102,19 @@ typedef struct mg_level {
   fcm_index *oct_body; /* and its body (the prolongations' check reads them) */
 } mg_level;
 
+/* A box grid mesh's cells on the grid, as level 0 of a grid hierarchy finds them (the mesh
+ * alone decides them): shared, by reference count, by the hierarchies carried over cuts on the
+ * same mesh (fcm__mg_create_pattern_cut()), so that a cut does not find them again. */
+typedef struct mg_grid {
+  int refs;
+  const fcm_mesh *mesh;
+  fcm_index grid[3];        /* cells along each axis */
+  fcm_index *node2;         /* 3 per mesh node: position on the half grid */
+  fcm_index *cell_ijk;      /* 3 per mesh cell: grid position */
+  fcm_index *cell_at;       /* per grid position: the mesh cell there, -1: none */
+  unsigned char bits_of[8]; /* corner bits of each local corner node */
+} mg_grid;
+
 struct fcm_mg {
   fcm_ctx *ctx;
   const fcm_space *space;
@@ -123,6 +136,7 @@ struct fcm_mg {
   /* the space whose pattern level 0's matrix had at creation (fcm__mg_pattern_of()), NULL
    * for none; kept by fcm__mg_detach(), only compared */
   const fcm_space *pattern_of;
+  mg_grid *mesh_grid; /* grid hierarchies: the mesh's grid (shared, fcm__mg_grid_release()) */
 };
 
 /* Threads of a parallel region: the context's now, at most those of the creation (scratch). */
@@ -247,6 +261,13 @@ static inline int fcm__mg_is_triple(const unsigned char *triple, fcm_index i, fc
  * when it is NULL, the eliminated rows of A; A (NULL with inactive0) is level 0's matrix. No
  * matrix is read beyond that: the prolongations depend on the space and the inactive rows. */
 fcm_status fcm__mg_build_hierarchy(fcm_mg *m, const fcm_csr *A, const unsigned char *inactive0);
+
+/* m shares `from`'s mesh grid (from: NULL or a hierarchy alive while m is made) when it is
+ * made on m's mesh; build_hierarchy() then takes it instead of finding it. */
+void fcm__mg_grid_share(fcm_mg *m, const fcm_mg *from);
+
+/* Drop a reference to *g (NULL: none), freeing it with the last one; *g = NULL. */
+void fcm__mg_grid_release(fcm_ctx *ctx, mg_grid **g);
 
 /* ---- octree.c */
 

@@ -15,6 +15,7 @@
  * lib/docs/multigrid_threads.md. */
 #include "mg/levels_impl.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,6 +55,7 @@ void fcm_mg_destroy(fcm_mg **mg)
     fcm_mesh_destroy(&m->oct_mesh[l]);
   }
   fcm__free(m->ctx, m->cut_cell);
+  fcm__mg_grid_release(m->ctx, &m->mesh_grid);
   fcm__free(m->ctx, m->blk_r);
   fcm__free(m->ctx, m->blk_dx);
   fcm__free(m->ctx, m);
@@ -200,25 +202,28 @@ static fcm_status galerkin_pattern(fcm_mg *m, int l, mg_carry *carry)
   FCM_TRY(ctx, level_diag(m, C));
   {
     /* the transposed positions, found once: every setup symmetrizes with them. Row by row,
-     * the entries (j, i) with i < j come in ascending i, as row j stores them: next[j] walks
-     * row j along. */
+     * the entries (j, i) with i < j come in ascending i, as row j stores them (the pattern of
+     * R A P is symmetric, A's being so): next[j] walks row j's lower triangle along, which
+     * each row's count checks (it ends on the diagonal). */
     const fcm_index *cp = fcm_csr_row_ptr(C->Aown);
     const int *cc = fcm_csr_col_idx(C->Aown);
+    FCM_CHECK(cp[C->n] <= INT_MAX, ctx, FCM_ERR_UNSUPPORTED,
+              "mg: level %d: %lld entries do not fit the transposed positions' 32-bit range", l + 1,
+              (long long)cp[C->n]);
     FCM_ALLOC_RAW(ctx, cp[C->n] + 1, C->tpos); /* every entry written below */
     FCM_ALLOC_RAW(ctx, C->n + 1, next);
     memcpy(next, cp, sizeof *next * (size_t)C->n);
+    int *tpos = C->tpos;
     for (fcm_index i = 0; i < C->n; i++)
       for (fcm_index p = cp[i]; p < cp[i + 1]; p++) {
         const fcm_index j = cc[p];
-        C->tpos[p] = -1;
-        if (j <= i) continue;
-        while (next[j] < cp[j + 1] && cc[next[j]] < i)
-          next[j]++;
-        FCM_CHECK(next[j] < cp[j + 1] && cc[next[j]] == i, ctx, FCM_ERR_INTERNAL,
-                  "mg: level %d: the Galerkin pattern has (%lld, %lld) but not its transpose",
-                  l + 1, (long long)i, (long long)j);
-        C->tpos[p] = next[j]++;
+        tpos[p] = j > i ? (int)next[j]++ : -1;
       }
+    for (fcm_index j = 0; j < C->n; j++)
+      FCM_CHECK(next[j] == C->diag[j], ctx, FCM_ERR_INTERNAL,
+                "mg: level %d: row %lld of the Galerkin pattern has %lld entries left of the "
+                "diagonal, its column %lld above",
+                l + 1, (long long)j, (long long)(C->diag[j] - cp[j]), (long long)(next[j] - cp[j]));
   }
 cleanup:
   fcm__free(ctx, next);
@@ -328,6 +333,7 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   m->nt = fcm_ctx_num_threads(ctx);
   m->values_pending = inactive != NULL;
   m->pattern_of = fcm__mg_pattern_of(space, A);
+  if (carry) fcm__mg_grid_share(m, carry->old); /* a cut keeps the mesh */
   FCM_TRY(ctx, fcm__mg_build_hierarchy(m, A, inactive));
   if (!fcm__mg_reuse_allowed(old, m)) old = NULL;
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));

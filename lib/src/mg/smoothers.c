@@ -477,7 +477,7 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
     for (int a = 0; a < 8; a++)
       mark[cells[(fcm_index)npc * c + a]] = 1;
   }
-  FCM_ALLOC(ctx, 2 * (size_t)ne * 8 * (mid ? 4 : 1) + 1, pairs);
+  FCM_ALLOC_RAW(ctx, 2 * (size_t)ne * 8 * (mid ? 4 : 1) + 1, pairs); /* read up to np */
   for (fcm_index e = 0; e < ne; e++) {
     const fcm_index c = fcm_space_element_cell(sp, e), *ed = fcm_space_element_dofs(sp, e);
     for (int a = 0; a < 8; a++) {

@@ -78,20 +78,23 @@ fcm_status fcm__mg_scalar_prolongation(fcm_ctx *ctx, const mg_level *F, const mg
   fcm_status st = FCM_OK;
   const fcm_index nk = F->ncopy;
   FCM_ALLOC(ctx, nk + 1, *scal_ptr);
-  FCM_ALLOC(ctx, 8 * nk + 1, *scal_col);
-  FCM_ALLOC(ctx, 8 * nk + 1, *scal_w);
+  FCM_ALLOC_RAW(ctx, 8 * nk + 1, *scal_col); /* read up to scal_ptr[nk], written below */
+  FCM_ALLOC_RAW(ctx, 8 * nk + 1, *scal_w);
   fcm_index *sp = *scal_ptr, *sc = *scal_col;
   double *sw = *scal_w;
   for (fcm_index k = 0; k < nk; k++) {
     fcm_index cnt = sp[k];
     if (cptr[k + 1] > cptr[k]) {
       const fcm_index c0 = cusers[cptr[k]];
-      for (int b = 0; b < 8; b++) {
-        double w = 1.0;
-        for (int d = 0; d < 3; d++) {
-          const fcm_index p = F->copy_ijk[3 * k + d], q = 2 * (C->ijk[3 * c0 + d] + (b >> d & 1));
-          w *= p == q ? 1.0 : (p == q - 1 || p == q + 1) ? 0.5 : 0.0;
+      /* the weights along each axis of the corner bit 0 (node 2 q) and 1 (node 2 q + 2) */
+      double along[3][2];
+      for (int d = 0; d < 3; d++)
+        for (int t = 0; t < 2; t++) {
+          const fcm_index off = F->copy_ijk[3 * k + d] - 2 * (C->ijk[3 * c0 + d] + t);
+          along[d][t] = off == 0 ? 1.0 : (off == -1 || off == 1) ? 0.5 : 0.0;
         }
+      for (int b = 0; b < 8; b++) {
+        const double w = 1.0 * along[0][b & 1] * along[1][b >> 1 & 1] * along[2][b >> 2 & 1];
         if (w == 0.0) continue;
         sc[cnt] = C->corner[8 * c0 + b];
         sw[cnt++] = w;
@@ -132,8 +135,8 @@ fcm_status fcm__mg_dof_prolongation(fcm_ctx *ctx, mg_level *F, const mg_level *C
     if (!pass) {
       for (fcm_index i = 0; i < F->n; i++)
         F->P_ptr[i + 1] += F->P_ptr[i];
-      FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_col);
-      FCM_ALLOC(ctx, F->P_ptr[F->n] + 1, F->P_val);
+      FCM_ALLOC_RAW(ctx, F->P_ptr[F->n] + 1, F->P_col); /* every entry written by pass 1 */
+      FCM_ALLOC_RAW(ctx, F->P_ptr[F->n] + 1, F->P_val);
     }
   }
 cleanup:
