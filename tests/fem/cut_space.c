@@ -7,6 +7,7 @@
  * and a space before the cut with one stale offset, two cells of its block order or two blocks
  * of different colours swapped, gives a different space (the offsets, the blocks and their
  * colours are taken where neither space has constrained copies, and the comparison sees them).
+ * The spaces (and a local space) made on 1, 2 and 3 threads are the same bit for bit.
  * Usage: fem_cut_space <element> */
 #include "fem/fem_impl.h"
 #include "test.h"
@@ -236,6 +237,82 @@ static int run_take(const fcm_mesh *mesh, const fcm_geometry *g)
   return taken;
 }
 
+/* The local topology's arrays of two local spaces (copies, elements, graph, pattern, offsets,
+ * colours). */
+static int same_local(const fcm_space *a, const fcm_space *b)
+{
+  const size_t I = sizeof(fcm_index), nn = (size_t)a->nn;
+  const size_t nl = (size_t)a->num_local_copies, nle = (size_t)a->num_local_elems;
+  if (a->num_local_copies != b->num_local_copies || a->num_local_elems != b->num_local_elems ||
+      a->num_colors != b->num_colors || a->num_dofs != b->num_dofs || !a->node_ptr || !b->node_ptr)
+    return 0;
+  return same(a->local_copy, b->local_copy, nl, I) && same(a->local_elem, b->local_elem, nle, I) &&
+         same(a->node_ptr, b->node_ptr, nl + 1, I) &&
+         same(a->node_adj, b->node_adj, (size_t)a->node_ptr[nl], I) &&
+         same(a->row_ptr, b->row_ptr, 3 * nl + 1, I) &&
+         same(a->col_idx, b->col_idx, (size_t)a->row_ptr[3 * nl], sizeof(int)) &&
+         same(a->elem_off, b->elem_off, nle * nn * nn, sizeof(int)) &&
+         same(a->elem_lcopy, b->elem_lcopy, nle * nn, sizeof(int)) &&
+         same(a->color_ptr, b->color_ptr, (size_t)a->num_colors + 1, I) &&
+         same(a->color_elems, b->color_elems, nle, I);
+}
+
+/* The spaces of the three cuts (each patched from the last; ratio: the constraint ratio) and a
+ * local space of the last cut's rules made on 1, 2 and 3 threads are the same bit for bit.
+ * Returns the cut spaces compared. */
+static int run_threads(const fcm_mesh *mesh, const fcm_geometry *g, double ratio)
+{
+  fcm_space_options so = fcm_space_options_default();
+  so.constrain_ratio = ratio;
+  fcm_cell_rules *rules[4] = {NULL, NULL, NULL, NULL};
+  fcm_space *space[3][4] = {{NULL}}, *local[3] = {NULL, NULL, NULL};
+  int compared = 0;
+  const double box_lo[3] = {-0.2, -0.2, -0.2}, box_hi[3] = {1.2, 0.8, 0.8};
+  const double p1[3] = {0.47, 0.3, 0.3}, n1[3] = {1.0, 0.05, 0.0};
+  const double c2[3] = {0.73, 0.55, 0.3}, n2[3] = {1.0, 0.0, 0.1}, a2[3] = {0.0, 1.0, 0.0},
+               size2[2] = {0.5, 2.0};
+  const double p3[3] = {0.5, 0.33, 0.3}, n3[3] = {0.04, 1.0, 0.02};
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, NULL, &rules[0]));
+  for (int k = 1; k <= 3 && rules[k - 1]; k++) {
+    fcm_surface *cut = NULL;
+    if (k == 1) TEST_OK(ctx, fcm_surface_create_plane(ctx, p1, n1, box_lo, box_hi, &cut));
+    if (k == 2) TEST_OK(ctx, fcm_surface_create_rectangle(ctx, c2, n2, a2, size2, &cut));
+    if (k == 3) TEST_OK(ctx, fcm_surface_create_plane(ctx, p3, n3, box_lo, box_hi, &cut));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, rules[k - 1], cut, &rules[k]));
+    fcm_surface_destroy(&cut);
+  }
+  const fcm_index ncells = fcm_mesh_num_cells(mesh);
+  unsigned char *mask = calloc((size_t)ncells, 1);
+  for (fcm_index c = 0; mask && c < ncells; c += 2) /* every other cell: a local space */
+    mask[c] = 1;
+  for (int t = 0; t < 3; t++) {
+    TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, t + 1));
+    TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[0], &so, &space[t][0]));
+    for (int k = 1; k <= 3 && rules[k] && space[t][k - 1]; k++)
+      TEST_OK(ctx, fcm__space_create_cut(ctx, mesh, rules[k], &so, space[t][k - 1], &space[t][k]));
+    if (rules[3])
+      TEST_OK(ctx, fcm__space_create_local(ctx, mesh, NULL, rules[3], &so, mask, &local[t]));
+  }
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, FCM_DEFAULT));
+  for (int t = 1; t < 3; t++) {
+    for (int k = 0; k <= 3; k++) {
+      TEST_TRUE(space[0][k] && space[t][k] && same_space(space[0][k], space[t][k]));
+      compared += k > 0 && space[0][k] && space[t][k];
+    }
+    TEST_TRUE(local[0] && local[t] && same_local(local[0], local[t]));
+  }
+  TEST_TRUE(space[0][3] && space[0][3]->cut_kept_rows > 0); /* the patch was exercised */
+  for (int t = 0; t < 3; t++) {
+    fcm_space_destroy(&local[t]);
+    for (int k = 3; k >= 0; k--)
+      fcm_space_destroy(&space[t][k]);
+  }
+  for (int k = 3; k >= 0; k--)
+    fcm_cell_rules_destroy(&rules[k]);
+  free(mask);
+  return compared;
+}
+
 int main(int argc, char **argv)
 {
   fcm_element_type type;
@@ -253,6 +330,8 @@ int main(int argc, char **argv)
   /* the tets' active cells make several blocks (the hexahedra's fit in one) */
   if (fcm_element_get_info(type)->num_corners == 4) TEST_TRUE(block_colors_swapped > 0);
   TEST_TRUE(run_take(mesh, g) >= 2); /* the third cut adds more than the room */
+  TEST_TRUE(run_threads(mesh, g, fcm_space_options_default().constrain_ratio) == 6);
+  TEST_TRUE(run_threads(mesh, g, 0.2) == 6);
   fcm_geometry_destroy(&g);
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);

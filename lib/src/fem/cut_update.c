@@ -47,16 +47,27 @@ fcm_status fcm__space_cut_parents_with(const fcm_space *from, const fcm_space *t
   fcm_ctx *ctx = to ? to->ctx : NULL;
   FCM_TRY(ctx, fcm__space_check_cut_pair(from, to, "cut parents"));
   FCM_CHECK(parent, ctx, FCM_ERR_ARG, "cut parents: parent is NULL");
-  const fcm_index nn = to->nn;
+  const fcm_index nn = to->nn, ne = to->num_elems;
+  const int nt = fcm_ctx_num_threads(ctx);
+  fcm_index bad = ne;
+#pragma omp parallel for num_threads(nt) schedule(static)
   for (fcm_index k = 0; k < to->num_dofs / 3; k++)
     parent[k] = -1;
-  for (fcm_index e = 0; e < to->num_elems; e++) {
-    const fcm_index fe = fcm__space_cut_parent_elem(from, to, e);
+  if (parent_elem) {
+    /* the parent elements by the threads (the first element without one, if any, reported) */
+#pragma omp parallel for num_threads(nt) schedule(static) reduction(min : bad)
+    for (fcm_index e = 0; e < ne; e++) {
+      parent_elem[e] = fcm__space_cut_parent_elem(from, to, e);
+      if (parent_elem[e] < 0) bad = FCM_MIN(bad, e);
+    }
+  }
+  for (fcm_index e = 0; e < ne; e++) {
+    const fcm_index fe =
+        parent_elem ? (e < bad ? parent_elem[e] : -1) : fcm__space_cut_parent_elem(from, to, e);
     FCM_CHECK(fe >= 0, ctx, FCM_ERR_INTERNAL,
               "cut parents: element %lld (cell %lld) has its parent piece outside the cell's "
               "pieces in the source",
               (long long)e, (long long)to->elem_cell[e]);
-    if (parent_elem) parent_elem[e] = fe;
     for (int a = 0; a < nn; a++) {
       const fcm_index k = to->elem_dof[e * nn + a] / 3;
       /* a constrained place holds another copy, which its own elements name */

@@ -405,6 +405,9 @@ fcm_status fcm__space_build_elements(fcm_space *s);
 /* The elements at each node: CSR over the nodes (*inc_ptr, *inc allocated). (numbering.c) */
 fcm_status fcm__space_build_incidence(fcm_space *s, fcm_index **inc_ptr, fcm_index **inc);
 
+/* Sort list[0..n) ascending (a few entries: insertion sort; more: qsort). */
+void fcm__space_sort_indices(fcm_index *list, fcm_index n);
+
 /* The copies of each node (generalized enrichment) and elem_dof. (numbering.c) */
 fcm_status fcm__space_build_copies(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc);
 

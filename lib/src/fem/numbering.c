@@ -5,29 +5,43 @@
 #include "fem/fem_impl.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Node -> elements incidence as CSR: inc_ptr[num_nodes+1], inc (ascending elements). */
+/* Node -> elements incidence as CSR: inc_ptr[num_nodes+1], inc (ascending elements). The
+ * threads count and place the elements in any order; each list is then sorted. */
 fcm_status fcm__space_build_incidence(fcm_space *s, fcm_index **inc_ptr, fcm_index **inc)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  const int nt = fcm_ctx_num_threads(ctx);
   fcm_index *ptr = NULL, *list = NULL, *fill = NULL;
   FCM_ALLOC(ctx, s->num_nodes + 1, ptr);
-  for (fcm_index e = 0; e < s->num_elems; e++)
-    for (int a = 0; a < s->nn; a++)
-      ptr[cells[s->elem_cell[e] * s->nn + a] + 1]++;
-  for (fcm_index n = 0; n < s->num_nodes; n++)
-    ptr[n + 1] += ptr[n];
-  FCM_ALLOC(ctx, ptr[s->num_nodes], list);
-  FCM_ALLOC(ctx, s->num_nodes, fill);
+#pragma omp parallel for num_threads(nt) schedule(static)
   for (fcm_index e = 0; e < s->num_elems; e++)
     for (int a = 0; a < s->nn; a++) {
-      fcm_index n = cells[s->elem_cell[e] * s->nn + a];
-      list[ptr[n] + fill[n]++] = e;
+#pragma omp atomic
+      ptr[cells[s->elem_cell[e] * s->nn + a] + 1]++;
     }
+  for (fcm_index n = 0; n < s->num_nodes; n++)
+    ptr[n + 1] += ptr[n];
+  FCM_ALLOC_RAW(ctx, ptr[s->num_nodes] + 1, list);
+  FCM_ALLOC_RAW(ctx, s->num_nodes + 1, fill);
+  memcpy(fill, ptr, sizeof *fill * (size_t)s->num_nodes);
+#pragma omp parallel for num_threads(nt) schedule(static)
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    for (int a = 0; a < s->nn; a++) {
+      const fcm_index n = cells[s->elem_cell[e] * s->nn + a];
+      fcm_index at;
+#pragma omp atomic capture
+      at = fill[n]++;
+      list[at] = e;
+    }
+#pragma omp parallel for num_threads(nt) schedule(static)
+  for (fcm_index n = 0; n < s->num_nodes; n++)
+    fcm__space_sort_indices(list + ptr[n], ptr[n + 1] - ptr[n]);
   *inc_ptr = ptr;
   *inc = list;
   ptr = list = NULL;
@@ -45,16 +59,23 @@ fcm_status fcm__space_build_elements(fcm_space *s)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   fcm_index ne = 0;
+  const int nt = fcm_ctx_num_threads(ctx);
   FCM_ALLOC(ctx, s->num_cells + 1, s->cell_elem);
+#pragma omp parallel for num_threads(nt) schedule(static)
   for (fcm_index c = 0; c < s->num_cells; c++) {
     fcm_index k = s->active[c];
     if (s->rules && s->active[c]) k = fcm_cell_rules_cell_pieces(s->rules, c, NULL);
-    s->cell_elem[c + 1] = s->cell_elem[c] + k;
+    s->cell_elem[c + 1] = k;
   }
+  for (fcm_index c = 0; c < s->num_cells; c++)
+    s->cell_elem[c + 1] += s->cell_elem[c];
   ne = s->num_elems = s->cell_elem[s->num_cells];
-  FCM_ALLOC(ctx, ne + 1, s->elem_cell);
-  FCM_ALLOC(ctx, ne + 1, s->elem_piece);
-  FCM_ALLOC(ctx, (size_t)ne * s->nn + 1, s->elem_dof);
+  /* every entry is written below (elem_dof: at each of an element's nodes, by
+   * fcm__space_build_copies()) */
+  FCM_ALLOC_RAW(ctx, ne + 1, s->elem_cell);
+  FCM_ALLOC_RAW(ctx, ne + 1, s->elem_piece);
+  FCM_ALLOC_RAW(ctx, (size_t)ne * s->nn + 1, s->elem_dof);
+#pragma omp parallel for num_threads(nt) schedule(static)
   for (fcm_index c = 0; c < s->num_cells; c++) {
     fcm_index first = 0;
     if (s->rules) fcm_cell_rules_cell_pieces(s->rules, c, &first);
@@ -74,12 +95,75 @@ static fcm_index uf_find(fcm_index *uf, fcm_index a)
   return a;
 }
 
+/* The position of element e in the ascending list sup[0..deg) (a node's support), -1: none. */
+static fcm_index support_pos(const fcm_index *sup, fcm_index deg, fcm_index e)
+{
+  fcm_index lo = 0, hi = deg;
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (sup[mid] < e)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo < deg && sup[lo] == e ? lo : -1;
+}
+
+/* The copies of the node whose support (ascending elements) is sup[0..deg): their number, and
+ * in comp[i] the copy (component) of element sup[i]; uf: deg entries of scratch. */
+static fcm_index node_components(const fcm_space *s, const fcm_index *link_ptr,
+                                 const fcm_index *links, const fcm_index *sup, fcm_index deg,
+                                 fcm_index *uf, fcm_index *comp)
+{
+  if (deg == 0) return 0;
+  int split = 0;
+  for (fcm_index i = 0; i < deg; i++) {
+    const fcm_index e = sup[i], c = s->elem_cell[e];
+    /* cuts reach the node's support: a cell split into pieces, a piece with a face on a
+     * cut (a cut along cell faces splits no cell but separates them), or a cell a cut
+     * passes near: the material of the support can be connected only through cells
+     * outside it (around a hole), and a cut elsewhere can sever that; the links are
+     * known around every such cell */
+    split |= s->cell_elem[c + 1] - s->cell_elem[c] > 1 ||
+             (s->rules && s->rules->reached && s->rules->reached[c]) ||
+             (s->rules && fcm_cell_rules_get_piece_cut_faces(s->rules, s->elem_piece[e], NULL) > 0);
+    uf[i] = i;
+  }
+  if (!split) {
+    for (fcm_index i = 0; i < deg; i++)
+      comp[i] = 0;
+    return 1;
+  }
+  for (fcm_index i = 0; i < deg; i++) {
+    /* links (p, q) with p the piece of this element */
+    const fcm_index p = s->elem_piece[sup[i]];
+    for (fcm_index l = link_ptr[p]; l < link_ptr[p + 1]; l++) {
+      /* the element of piece q: pieces and elements of a cell are in the same order */
+      const fcm_index q = links[2 * l + 1];
+      const fcm_index cq = fcm_cell_rules_piece_cell(s->rules, q);
+      fcm_index fq;
+      fcm_cell_rules_cell_pieces(s->rules, cq, &fq);
+      const fcm_index j = support_pos(sup, deg, s->cell_elem[cq] + (q - fq));
+      if (j < 0) continue; /* not in this node's support */
+      const fcm_index ra = uf_find(uf, i), rb = uf_find(uf, j);
+      if (ra != rb) uf[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);
+    }
+  }
+  fcm_index k = 0;
+  for (fcm_index i = 0; i < deg; i++) {
+    const fcm_index r = uf_find(uf, i);
+    comp[i] = r == i ? k++ : comp[r];
+  }
+  return k;
+}
+
 /* Generalized enrichment (Ton-That et al. 2024, XFEM): the elements incident to a node
  * (its support) are grouped into connected components along the links of the cell rules
  * (pieces of face-neighbouring cells that share a face part not lying on a cut); each
  * component gets its own copy of the node. Where every incident cell has one piece, the
  * node has one copy. Copies are numbered node by node, components by their first element;
- * elem_dof gets the copy each element uses. */
+ * elem_dof gets the copy each element uses. The nodes' components are found by the threads
+ * (comp: the component of every incidence entry), then numbered in node order. */
 fcm_status fcm__space_build_copies(fcm_space *s, const fcm_index *inc_ptr, const fcm_index *inc)
 {
   fcm_status st = FCM_OK;
@@ -87,9 +171,11 @@ fcm_status fcm__space_build_copies(fcm_space *s, const fcm_index *inc_ptr, const
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
   const fcm_index nl = s->rules ? fcm_cell_rules_num_links(s->rules) : 0;
   const fcm_index *links = s->rules ? fcm_cell_rules_links(s->rules) : NULL;
-  fcm_index *uf = NULL, *comp = NULL, *pos = NULL, *link_ptr = NULL, ncopy = 0, maxdeg = 0;
   const fcm_index npieces = s->rules ? fcm_cell_rules_num_pieces(s->rules) : 0;
-  FCM_ALLOC(ctx, s->num_nodes, s->node_ncopy);
+  const fcm_index nnodes = s->num_nodes;
+  const int nt = fcm_ctx_num_threads(ctx);
+  fcm_index *uf = NULL, *comp = NULL, *link_ptr = NULL, ncopy = 0, maxdeg = 0;
+  FCM_ALLOC(ctx, nnodes, s->node_ncopy);
   /* links (p, q) sorted by p: those of piece p are [link_ptr[p], link_ptr[p + 1]) */
   FCM_ALLOC(ctx, npieces + 1, link_ptr);
   for (fcm_index p = 0, l = 0; p <= npieces; p++) {
@@ -97,74 +183,35 @@ fcm_status fcm__space_build_copies(fcm_space *s, const fcm_index *inc_ptr, const
       l++;
     link_ptr[p] = l;
   }
-  for (fcm_index n = 0; n < s->num_nodes; n++)
+#pragma omp parallel for num_threads(nt) schedule(static) reduction(max : maxdeg)
+  for (fcm_index n = 0; n < nnodes; n++)
     maxdeg = FCM_MAX(maxdeg, inc_ptr[n + 1] - inc_ptr[n]);
-  FCM_ALLOC(ctx, maxdeg + 1, uf);
-  FCM_ALLOC(ctx, maxdeg + 1, comp);
-  FCM_ALLOC(ctx, s->num_elems + 1, pos);
-  for (fcm_index e = 0; e < s->num_elems; e++)
-    pos[e] = -1;
-  for (fcm_index n = 0; n < s->num_nodes; n++) {
-    const fcm_index i0 = inc_ptr[n], deg = inc_ptr[n + 1] - i0;
-    s->node_dof[n] = -1;
-    if (deg == 0) continue;
-    int split = 0;
-    for (fcm_index i = 0; i < deg; i++) {
-      const fcm_index e = inc[i0 + i], c = s->elem_cell[e];
-      /* cuts reach the node's support: a cell split into pieces, a piece with a face on a
-       * cut (a cut along cell faces splits no cell but separates them), or a cell a cut
-       * passes near: the material of the support can be connected only through cells
-       * outside it (around a hole), and a cut elsewhere can sever that; the links are
-       * known around every such cell */
-      split |=
-          s->cell_elem[c + 1] - s->cell_elem[c] > 1 ||
-          (s->rules && s->rules->reached && s->rules->reached[c]) ||
-          (s->rules && fcm_cell_rules_get_piece_cut_faces(s->rules, s->elem_piece[e], NULL) > 0);
-      uf[i] = i;
-      pos[e] = i;
-    }
-    fcm_index k = 1;
-    if (split) {
-      for (fcm_index i = 0; i < deg; i++) {
-        /* links (p, q) with p the piece of this element */
-        const fcm_index p = s->elem_piece[inc[i0 + i]];
-        for (fcm_index l = link_ptr[p]; l < link_ptr[p + 1]; l++) {
-          /* the element of piece q: pieces and elements of a cell are in the same order */
-          const fcm_index q = links[2 * l + 1];
-          const fcm_index cq = fcm_cell_rules_piece_cell(s->rules, q);
-          fcm_index fq;
-          fcm_cell_rules_cell_pieces(s->rules, cq, &fq);
-          const fcm_index eq = s->cell_elem[cq] + (q - fq);
-          if (pos[eq] < 0) continue; /* not in this node's support */
-          const fcm_index ra = uf_find(uf, i), rb = uf_find(uf, pos[eq]);
-          if (ra != rb) uf[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);
-        }
-      }
-      k = 0;
-      for (fcm_index i = 0; i < deg; i++) {
-        const fcm_index r = uf_find(uf, i);
-        comp[i] = r == i ? k++ : comp[r];
-      }
-    } else {
-      for (fcm_index i = 0; i < deg; i++)
-        comp[i] = 0;
-    }
-    s->node_ncopy[n] = k;
-    s->node_dof[n] = 3 * ncopy;
-    for (fcm_index i = 0; i < deg; i++) {
-      const fcm_index e = inc[i0 + i];
+  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)(maxdeg + 1), uf);
+  FCM_ALLOC_RAW(ctx, inc_ptr[nnodes] + 1, comp);
+#pragma omp parallel num_threads(nt)
+  {
+    fcm_index *u = uf + (size_t)omp_get_thread_num() * (size_t)(maxdeg + 1);
+#pragma omp for schedule(dynamic, 512)
+    for (fcm_index n = 0; n < nnodes; n++)
+      s->node_ncopy[n] = node_components(s, link_ptr, links, inc + inc_ptr[n],
+                                         inc_ptr[n + 1] - inc_ptr[n], u, comp + inc_ptr[n]);
+  }
+  for (fcm_index n = 0; n < nnodes; n++) {
+    s->node_dof[n] = inc_ptr[n + 1] > inc_ptr[n] ? 3 * ncopy : -1;
+    ncopy += s->node_ncopy[n];
+  }
+#pragma omp parallel for num_threads(nt) schedule(static)
+  for (fcm_index n = 0; n < nnodes; n++)
+    for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
+      const fcm_index e = inc[i];
       for (int a = 0; a < s->nn; a++)
         if (cells[s->elem_cell[e] * s->nn + a] == n)
-          s->elem_dof[e * s->nn + a] = 3 * (ncopy + comp[i]);
-      pos[e] = -1;
+          s->elem_dof[e * s->nn + a] = s->node_dof[n] + 3 * comp[i];
     }
-    ncopy += k;
-  }
   s->num_dofs = 3 * ncopy;
 cleanup:
   fcm__free(ctx, uf);
   fcm__free(ctx, comp);
-  fcm__free(ctx, pos);
   fcm__free(ctx, link_ptr);
   return st;
 }
@@ -206,13 +253,24 @@ fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_ind
   FCM_ALLOC(ctx, ncopy + 1, uf);
   FCM_ALLOC(ctx, ncopy + 1, node_of);
   FCM_ALLOC(ctx, ncopy + 1, anchor);
-  fcm__space_copy_support(s, venr);
-  /* which copies are tiny, each against its own node's support */
+  /* which copies are tiny, each against its own node's support; a copy's support (as
+   * fcm__space_copy_support(): its elements' volumes in ascending order) from its node's
+   * elements, every copy being one node's before the constraint */
   fcm_index ntiny = 0;
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(static) reduction(+ : ntiny)
   for (fcm_index n = 0; n < s->num_nodes; n++) {
     double vsupp = 0.0;
-    for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++)
-      vsupp += fcm_cell_rules_piece_volume(s->rules, s->elem_piece[inc[i]]);
+    for (fcm_index c = 0; c < s->node_ncopy[n]; c++)
+      venr[s->node_dof[n] / 3 + c] = 0.0;
+    for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
+      const fcm_index e = inc[i];
+      const double v = fcm_cell_rules_piece_volume(s->rules, s->elem_piece[e]);
+      int a = 0;
+      while (a < nn - 1 && cells[s->elem_cell[e] * nn + a] != n)
+        a++;
+      venr[s->elem_dof[e * nn + a] / 3] += v;
+      vsupp += v;
+    }
     for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
       const fcm_index k = s->node_dof[n] / 3 + c;
       node_of[k] = n;

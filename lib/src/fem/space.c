@@ -9,6 +9,24 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The most points of any rule of cut cell c's pieces (in *most). */
+static fcm_status cell_cut_points(fcm_ctx *ctx, const fcm_cell_rules *rules, fcm_index c, int *most)
+{
+  fcm_status st = FCM_OK;
+  fcm_index first = 0;
+  const fcm_index np = fcm_cell_rules_cell_pieces(rules, c, &first);
+  *most = 0;
+  for (fcm_index p = first; p < first + np; p++)
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      int n = 0;
+      if (!fcm_cell_rules_has_kind(rules, (fcm_rule_kind)k)) continue; /* not built */
+      FCM_TRY(ctx, fcm_cell_rules_get_piece(rules, p, (fcm_rule_kind)k, &n, NULL, NULL, NULL));
+      *most = FCM_MAX(*most, n);
+    }
+cleanup:
+  return st;
+}
+
 /* Shared by fcm_space_create(), fcm_space_create_embedded(), fcm__space_create_local() (local
  * != 0: the topology of the cells flagged in cell_mask only) and fcm__space_create_cut() (from:
  * the space before the cut, whose topology the new one patches). */
@@ -20,6 +38,7 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
   fcm_status st = FCM_OK;
   fcm_space *s = NULL;
   fcm_index *inc_ptr = NULL, *inc = NULL, nactive_cells = 0;
+  int max_points = 0;
   FCM_CHECK(out, ctx, FCM_ERR_ARG, "space: output pointer is NULL");
   *out = NULL;
   FCM_CHECK(mesh, ctx, FCM_ERR_ARG, "space: mesh is NULL");
@@ -31,24 +50,28 @@ static fcm_status space_create(fcm_ctx *ctx, const fcm_mesh *mesh, const unsigne
   s->nn = fcm_mesh_nodes_per_cell(mesh);
   s->num_cells = fcm_mesh_num_cells(mesh);
   s->num_nodes = fcm_mesh_num_nodes(mesh);
-  FCM_ALLOC(ctx, s->num_cells, s->active);
+  FCM_ALLOC_RAW(ctx, s->num_cells + 1, s->active); /* every cell's written below */
+  fcm__loop loop;
+  fcm__loop_begin(ctx, &loop);
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(static) \
+    reduction(+ : nactive_cells) reduction(max : max_points)
   for (fcm_index c = 0; c < s->num_cells; c++) {
     s->active[c] = cell_active ? (cell_active[c] != 0) : 1;
     if (rules) {
       fcm_cell_class cls = fcm_cell_rules_class(rules, c);
       s->active[c] = cls != FCM_CELL_DROPPED;
-      fcm_index first = 0;
-      const fcm_index np = fcm_cell_rules_cell_pieces(rules, c, &first);
-      for (fcm_index p = first; p < first + np && cls == FCM_CELL_CUT; p++)
-        for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-          int n = 0;
-          if (!fcm_cell_rules_has_kind(rules, (fcm_rule_kind)k)) continue; /* not built */
-          FCM_TRY(ctx, fcm_cell_rules_get_piece(rules, p, (fcm_rule_kind)k, &n, NULL, NULL, NULL));
-          s->max_cut_points = FCM_MAX(s->max_cut_points, n);
-        }
+      if (cls == FCM_CELL_CUT && !fcm__loop_skip(&loop, c)) {
+        fcm__loop_iter it;
+        int n = 0;
+        fcm__loop_enter(&loop, &it, c);
+        fcm__loop_leave(&loop, &it, cell_cut_points(ctx, rules, c, &n));
+        max_points = FCM_MAX(max_points, n);
+      }
     }
     nactive_cells += s->active[c];
   }
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+  s->max_cut_points = max_points;
   FCM_CHECK(nactive_cells > 0, ctx, FCM_ERR_ARG, "space: none of the %lld cells is active",
             (long long)s->num_cells);
   FCM_ALLOC(ctx, s->num_nodes, s->node_dof);

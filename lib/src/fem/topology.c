@@ -5,6 +5,7 @@
 #include "fem/fem_impl.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -21,20 +22,39 @@ static fcm_index local_elem(const fcm_space *s, fcm_index le)
   return s->local_elem ? s->local_elem[le] : le;
 }
 
+void fcm__space_sort_indices(fcm_index *list, fcm_index n)
+{
+  if (n > 32) {
+    qsort(list, (size_t)n, sizeof *list, cmp_index);
+    return;
+  }
+  for (fcm_index i = 1; i < n; i++) {
+    const fcm_index v = list[i];
+    fcm_index j = i;
+    for (; j > 0 && list[j - 1] > v; j--)
+      list[j] = list[j - 1];
+    list[j] = v;
+  }
+}
+
 /* Copy -> elements incidence over the local topology: for each of the num_local_copies copies,
  * the local positions of the local elements using it at any local node (ascending, each once),
- * as CSR. g2l maps a copy rank to its local position (NULL: the identity, a full space). */
+ * as CSR. g2l maps a copy rank to its local position (NULL: the identity, a full space). The
+ * threads count and place the elements in any order; each list is then sorted, so the lists
+ * do not depend on the thread count. */
 static fcm_status build_copy_incidence(fcm_space *s, const fcm_index *g2l, fcm_index **ptr_out,
                                        fcm_index **list_out)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
-  const fcm_index ncopy = s->num_local_copies, nn = s->nn;
+  const fcm_index ncopy = s->num_local_copies, nn = s->nn, ne = s->num_local_elems;
+  const int nt = fcm_ctx_num_threads(ctx);
   fcm_index *ptr = NULL, *list = NULL, *fill = NULL;
   FCM_ALLOC(ctx, ncopy + 1, ptr);
-  FCM_ALLOC(ctx, ncopy + 1, fill);
+  FCM_ALLOC_RAW(ctx, ncopy + 1, fill);
   for (int pass = 0; pass < 2; pass++) {
-    for (fcm_index le = 0; le < s->num_local_elems; le++) {
+#pragma omp parallel for num_threads(nt) schedule(static)
+    for (fcm_index le = 0; le < ne; le++) {
       const fcm_index *ed = s->elem_dof + local_elem(s, le) * nn;
       for (int a = 0; a < nn; a++) {
         const fcm_index k = g2l ? g2l[ed[a] / 3] : ed[a] / 3;
@@ -42,18 +62,27 @@ static fcm_status build_copy_incidence(fcm_space *s, const fcm_index *g2l, fcm_i
         for (int b = 0; b < a && !dup; b++)
           dup = ed[b] / 3 == ed[a] / 3;
         if (dup) continue;
-        if (pass)
-          list[ptr[k] + fill[k]++] = le;
-        else
+        if (pass) {
+          fcm_index at;
+#pragma omp atomic capture
+          at = fill[k]++;
+          list[at] = le;
+        } else {
+#pragma omp atomic
           ptr[k + 1]++;
+        }
       }
     }
     if (!pass) {
       for (fcm_index k = 0; k < ncopy; k++)
         ptr[k + 1] += ptr[k];
-      FCM_ALLOC(ctx, ptr[ncopy] + 1, list);
+      memcpy(fill, ptr, sizeof *fill * (size_t)ncopy);
+      FCM_ALLOC_RAW(ctx, ptr[ncopy] + 1, list);
     }
   }
+#pragma omp parallel for num_threads(nt) schedule(static)
+  for (fcm_index k = 0; k < ncopy; k++)
+    fcm__space_sort_indices(list + ptr[k], ptr[k + 1] - ptr[k]);
   *ptr_out = ptr, *list_out = list;
   ptr = list = NULL;
 cleanup:
@@ -98,6 +127,7 @@ static fcm_status node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index
 static void fill_columns(fcm_space *s)
 {
   const fcm_index nact = s->num_local_copies;
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(s->ctx)) schedule(static)
   for (fcm_index k = 0; k < nact; k++)
     for (int i = 0; i < 3; i++) {
       int *cols = s->col_idx + s->row_ptr[3 * k + i];
@@ -115,11 +145,14 @@ static fcm_status build_pattern_rows(fcm_space *s, fcm_space *give)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   const fcm_index nact = s->num_local_copies, nrow = 3 * nact;
-  FCM_ALLOC(ctx, nrow + 1, s->row_ptr);
+  FCM_ALLOC_RAW(ctx, nrow + 1, s->row_ptr);
+  s->row_ptr[0] = 0;
+  /* the rows of copy k start at 9 node_ptr[k] (three rows of three columns a neighbour) */
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(static)
   for (fcm_index k = 0; k < nact; k++) {
-    fcm_index deg = s->node_ptr[k + 1] - s->node_ptr[k];
+    const fcm_index deg = s->node_ptr[k + 1] - s->node_ptr[k];
     for (int i = 0; i < 3; i++)
-      s->row_ptr[3 * k + i + 1] = s->row_ptr[3 * k + i] + 3 * deg;
+      s->row_ptr[3 * k + i + 1] = 9 * s->node_ptr[k] + 3 * (i + 1) * deg;
   }
   const size_t nnz = (size_t)s->row_ptr[nrow];
   if (give && give->col_idx && !give->col_from && nnz <= give->col_cap &&
@@ -366,13 +399,16 @@ typedef struct cut_map {
 static void count_uses(const fcm_space *s, fcm_index *uses)
 {
   const int nn = s->nn;
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(s->ctx)) schedule(static)
   for (fcm_index e = 0; e < s->num_elems; e++) {
     const fcm_index *ed = s->elem_dof + e * nn;
     for (int a = 0; a < nn; a++) {
       int dup = 0;
       for (int b = 0; b < a && !dup; b++)
         dup = ed[b] / 3 == ed[a] / 3;
-      if (!dup) uses[ed[a] / 3]++;
+      if (dup) continue;
+#pragma omp atomic
+      uses[ed[a] / 3]++;
     }
   }
 }
@@ -381,6 +417,7 @@ static void count_uses(const fcm_space *s, fcm_index *uses)
 static void mark_kept_elements(const fcm_space *from, const fcm_space *s, cut_map *m)
 {
   const int nn = s->nn;
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(s->ctx)) schedule(static)
   for (fcm_index e = 0; e < s->num_elems; e++) {
     const fcm_index c = s->elem_cell[e], fe = m->parent_elem[e];
     int kept =
@@ -404,13 +441,16 @@ static fcm_status build_cut_map(const fcm_space *from, const fcm_space *s, const
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   const fcm_index ncopy = s->num_dofs / 3, nold = from->num_dofs / 3;
-  FCM_ALLOC(ctx, ncopy + 1, m->parent);
-  FCM_ALLOC(ctx, nold + 1, m->child);
+  const int nt = fcm_ctx_num_threads(ctx);
+  /* every entry is written below but old_uses' (counts) */
+  FCM_ALLOC_RAW(ctx, ncopy + 1, m->parent);
+  FCM_ALLOC_RAW(ctx, nold + 1, m->child);
   FCM_ALLOC(ctx, nold + 1, m->old_uses);
-  FCM_ALLOC(ctx, s->num_elems + 1, m->elem_kept);
-  FCM_ALLOC(ctx, ncopy + 1, m->copy_kept);
-  FCM_ALLOC(ctx, s->num_elems + 1, m->parent_elem);
+  FCM_ALLOC_RAW(ctx, s->num_elems + 1, m->elem_kept);
+  FCM_ALLOC_RAW(ctx, ncopy + 1, m->copy_kept);
+  FCM_ALLOC_RAW(ctx, s->num_elems + 1, m->parent_elem);
   FCM_TRY(ctx, fcm__space_cut_parents_with(from, s, m->parent, m->parent_elem));
+#pragma omp parallel for num_threads(nt) schedule(static)
   for (fcm_index p = 0; p < nold; p++)
     m->child[p] = -1;
   for (fcm_index k = 0; k < ncopy; k++) {
@@ -419,6 +459,7 @@ static fcm_status build_cut_map(const fcm_space *from, const fcm_space *s, const
   }
   mark_kept_elements(from, s, m);
   count_uses(from, m->old_uses);
+#pragma omp parallel for num_threads(nt) schedule(static)
   for (fcm_index k = 0; k < ncopy; k++) {
     const fcm_index p = m->parent[k];
     int kept = p >= 0 && m->child[p] == k && cptr[k + 1] - cptr[k] == m->old_uses[p];
@@ -440,50 +481,72 @@ static void free_cut_map(fcm_ctx *ctx, cut_map *m)
   fcm__free(ctx, m->copy_kept);
 }
 
+/* Row k of the copy graph of a cut space from a kept copy's parent row (node_adj from base;
+ * row NULL: only its length). Returns the length, or -1 - i when the parent row's neighbour i
+ * has no single child. */
+static fcm_index kept_row(const fcm_space *from, cut_map *m, fcm_index k, fcm_index *row)
+{
+  const fcm_index p = m->parent[k], *prow = from->node_adj + from->node_ptr[p];
+  const fcm_index cnt = from->node_ptr[p + 1] - from->node_ptr[p];
+  if (!row) return cnt;
+  int sorted = 1;
+  for (fcm_index i = 0; i < cnt; i++) {
+    if (m->child[prow[i]] < 0) return -1 - i;
+    row[i] = m->child[prow[i]];
+    sorted &= i == 0 || row[i] > row[i - 1];
+  }
+  if (!sorted) qsort(row, (size_t)cnt, sizeof *row, cmp_index);
+  m->copy_kept[k] = (unsigned char)(sorted ? 2 : 1);
+  return cnt;
+}
+
+/* The rows are made by the threads, each with its own marks (mark: nt arrays of ncopy). */
 static fcm_status node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
                              const fcm_index *cinc, const fcm_space *from, cut_map *m)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   const fcm_index ncopy = s->num_local_copies;
-  fcm_index *mark = NULL;
-  FCM_ALLOC(ctx, ncopy + 1, mark);
+  const int nt = fcm_ctx_num_threads(ctx);
+  fcm_index *mark = NULL, bad = ncopy, kept_rows = 0;
+  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)(ncopy + 1), mark);
   FCM_ALLOC(ctx, ncopy + 1, s->node_ptr);
   for (int pass = 0; pass < 2; pass++) {
-    for (fcm_index k = 0; k < ncopy; k++)
-      mark[k] = -1;
-    for (fcm_index k = 0; k < ncopy; k++) {
-      fcm_index cnt = 0, base = pass ? s->node_ptr[k] : 0;
-      if (m && m->copy_kept[k]) {
-        const fcm_index p = m->parent[k], *row = from->node_adj + from->node_ptr[p];
-        cnt = from->node_ptr[p + 1] - from->node_ptr[p];
-        if (!pass) {
-          s->node_ptr[k + 1] = cnt;
-          continue;
+#pragma omp parallel num_threads(nt) reduction(min : bad) reduction(+ : kept_rows)
+    {
+      fcm_index *mk = mark + (size_t)omp_get_thread_num() * (size_t)(ncopy + 1);
+      for (fcm_index k = 0; k < ncopy; k++)
+        mk[k] = -1;
+#pragma omp for schedule(dynamic, 256)
+      for (fcm_index k = 0; k < ncopy; k++) {
+        fcm_index *row = pass ? s->node_adj + s->node_ptr[k] : NULL, cnt;
+        if (m && m->copy_kept[k]) {
+          cnt = kept_row(from, m, k, row);
+          if (cnt < 0) {
+            bad = FCM_MIN(bad, k);
+            continue;
+          }
+          kept_rows += pass;
+        } else {
+          cnt = copy_row(s, g2l, cptr, cinc, k, mk, row);
         }
-        int sorted = 1;
-        for (fcm_index i = 0; i < cnt; i++) {
-          FCM_CHECK(m->child[row[i]] >= 0, ctx, FCM_ERR_INTERNAL,
-                    "cut space: copy %lld is kept but its neighbour %lld before the cut has "
-                    "no single child",
-                    (long long)k, (long long)row[i]);
-          s->node_adj[base + i] = m->child[row[i]];
-          sorted &= i == 0 || s->node_adj[base + i] > s->node_adj[base + i - 1];
-        }
-        if (!sorted) qsort(s->node_adj + base, (size_t)cnt, sizeof *s->node_adj, cmp_index);
-        m->copy_kept[k] = (unsigned char)(sorted ? 2 : 1);
-        s->cut_kept_rows++;
-        continue;
+        if (!pass) s->node_ptr[k + 1] = cnt;
       }
-      cnt = copy_row(s, g2l, cptr, cinc, k, mark, pass ? s->node_adj + base : NULL);
-      if (!pass) s->node_ptr[k + 1] = cnt;
+    }
+    if (bad < ncopy) {
+      const fcm_index i = -1 - kept_row(from, m, bad, s->node_adj + s->node_ptr[bad]);
+      FCM_CHECK(0, ctx, FCM_ERR_INTERNAL,
+                "cut space: copy %lld is kept but its neighbour %lld before the cut has no "
+                "single child",
+                (long long)bad, (long long)from->node_adj[from->node_ptr[m->parent[bad]] + i]);
     }
     if (!pass) {
       for (fcm_index k = 0; k < ncopy; k++)
         s->node_ptr[k + 1] += s->node_ptr[k];
-      FCM_ALLOC(ctx, s->node_ptr[ncopy] + 1, s->node_adj);
+      FCM_ALLOC_RAW(ctx, s->node_ptr[ncopy] + 1, s->node_adj);
     }
   }
+  s->cut_kept_rows += kept_rows;
 cleanup:
   fcm__free(ctx, mark);
   return st;
@@ -496,7 +559,8 @@ static fcm_status patch_offsets(fcm_space *s, const fcm_space *from, const cut_m
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   const int nn = s->nn;
-  FCM_ALLOC(ctx, (size_t)s->num_elems * nn * nn + 1, s->elem_off);
+  FCM_ALLOC_RAW(ctx, (size_t)s->num_elems * nn * nn + 1, s->elem_off); /* all written below */
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(static)
   for (fcm_index e = 0; e < s->num_elems; e++) {
     const fcm_index fe = m->elem_kept[e] ? m->parent_elem[e] : -1;
     for (int a = 0; a < nn; a++) {
@@ -528,15 +592,21 @@ static fcm_status patch_colors(fcm_space *s, const fcm_space *from, const fcm_in
   int *color = NULL, *old = NULL, ncol = 0;
   unsigned char *dirty = NULL;
   fcm_index *forbid = NULL;
-  FCM_ALLOC(ctx, ne + 1, color);
-  FCM_ALLOC(ctx, ne + 1, dirty);
-  FCM_ALLOC(ctx, from->num_elems + 1, old);
+  const int nt = fcm_ctx_num_threads(ctx);
+  /* every entry is written below (every element of from has a colour) */
+  FCM_ALLOC_RAW(ctx, ne + 1, color);
+  FCM_ALLOC_RAW(ctx, ne + 1, dirty);
+  FCM_ALLOC_RAW(ctx, from->num_elems + 1, old);
   FCM_ALLOC(ctx, MAX_COLORS, forbid);
   for (int k = 0; k < MAX_COLORS; k++)
     forbid[k] = -1;
-  for (int c = 0; c < from->num_colors; c++)
-    for (fcm_index i = from->color_ptr[c]; i < from->color_ptr[c + 1]; i++)
+  for (int c = 0; c < from->num_colors; c++) {
+    const fcm_index i0 = from->color_ptr[c], i1 = from->color_ptr[c + 1];
+#pragma omp parallel for num_threads(nt) schedule(static) if (i1 - i0 > 4096)
+    for (fcm_index i = i0; i < i1; i++)
       old[from->color_elems[i]] = c;
+  }
+#pragma omp parallel for num_threads(nt) schedule(static)
   for (fcm_index e = 0; e < ne; e++) {
     int stable = m->elem_kept[e];
     for (int a = 0; a < nn && stable; a++)
@@ -617,6 +687,7 @@ static fcm_status mark_cut_rows(fcm_space *s, const fcm_space *from, const fcm_i
   s->cut_from_dofs = from->num_dofs;
   s->cut_from_elems = from->num_elems;
   if (s->blocks_kept) {
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(static)
     for (fcm_index k = 0; k < ncopy; k++)
       s->cut_row_from[k] = m->copy_kept[k] == 2 ? m->parent[k] : -1;
     return FCM_OK;
