@@ -16,6 +16,12 @@
  * triangle partly outside the mesh) it is kept whole. */
 #define SPLIT_AREA_RTOL 1e-9
 
+/* Points and triangles a surface is made with room for, per boundary vertex and triangle
+ * (surface_reserve()): Dick's Bunny 2 holds 2.8 points and 1.3 triangles per boundary vertex
+ * and triangle after its four cuts. */
+#define ROOM_POINTS    3
+#define ROOM_TRIANGLES 2
+
 /* The element of cell c integrating rules piece p; -1 when none does. */
 static fcm_index piece_element(const fcm_space *s, fcm_index c, fcm_index p)
 {
@@ -520,27 +526,45 @@ cleanup:
   return st;
 }
 
-/* Room for np points and nt triangles: half as much again as before when it grows, so that
- * the next cuts' parts (a few more each) seldom copy the arrays again. */
+/* *a (n_old x size, its first keep in use) as a new array of n: the rest not zeroed (written
+ * before it is read), so that only the pages written are touched. */
+static fcm_status grow(fcm_ctx *ctx, void **a, size_t keep, size_t n, size_t size)
+{
+  fcm_status st = FCM_OK;
+  void *fresh = fcm__malloc(ctx, n, size); /* reports the failure */
+  if (!fresh) {
+    st = FCM_ERR_ALLOC;
+    fcm__trace(ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
+  memcpy(fresh, *a, keep * size);
+  fcm__free(ctx, *a);
+  *a = fresh;
+cleanup:
+  return st;
+}
+
+/* Room for np points and nt triangles, the current ones kept: twice as much when it grows.
+ * The surface is made with room for its first cuts (ROOM_POINTS, ROOM_TRIANGLES): a cut then
+ * writes the parts and cut faces into pages already in memory, where a grown array's pages
+ * would be faulted in again (a few ms at 100k points). */
 static fcm_status surface_reserve(fcm_embedded_surface *es, fcm_index np, fcm_index nt)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
-  if (np > es->cap_p) np = FCM_MAX(np, es->cap_p + es->cap_p / 2);
-  if (nt > es->cap_t) nt = FCM_MAX(nt, es->cap_t + es->cap_t / 2);
   if (np > es->cap_p) {
-    const size_t old = (size_t)es->cap_p;
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->X, 3 * old, 3 * (size_t)np, sizeof(double)));
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->xi, 3 * old, 3 * (size_t)np, sizeof(double)));
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->cell, old, (size_t)np, sizeof(fcm_index)));
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->elem, old, (size_t)np, sizeof(fcm_index)));
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->flag, old, (size_t)np, sizeof(int32_t)));
-    es->cap_p = np;
+    const size_t n = (size_t)FCM_MAX(np, 2 * es->cap_p), keep = (size_t)FCM_MAX(es->np, es->nb);
+    FCM_TRY(ctx, grow(ctx, (void **)&es->X, 3 * keep, 3 * n, sizeof(double)));
+    FCM_TRY(ctx, grow(ctx, (void **)&es->xi, 3 * keep, 3 * n, sizeof(double)));
+    FCM_TRY(ctx, grow(ctx, (void **)&es->cell, keep, n, sizeof(fcm_index)));
+    FCM_TRY(ctx, grow(ctx, (void **)&es->elem, keep, n, sizeof(fcm_index)));
+    FCM_TRY(ctx, grow(ctx, (void **)&es->flag, keep, n, sizeof(int32_t)));
+    es->cap_p = (fcm_index)n;
   }
   if (nt > es->cap_t) {
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->tri, 3 * (size_t)es->cap_t, 3 * (size_t)nt,
-                             sizeof(fcm_index)));
-    es->cap_t = nt;
+    const size_t n = (size_t)FCM_MAX(nt, 2 * es->cap_t);
+    FCM_TRY(ctx, grow(ctx, (void **)&es->tri, 3 * (size_t)es->nt, 3 * n, sizeof(fcm_index)));
+    es->cap_t = (fcm_index)n;
   }
 cleanup:
   return st;
@@ -753,14 +777,14 @@ fcm_status fcm_embedded_surface_create(const fcm_space *s, const fcm_geometry *g
   fcm_index nb = 0;
   for (fcm_index k = 0; k < 3 * nt; k++)
     if (map[tri[k]] < 0) map[tri[k]] = nb++;
-  es->cap_p = nb;
-  es->cap_t = nt;
-  FCM_ALLOC(ctx, 3 * nb, es->X);
-  FCM_ALLOC(ctx, 3 * nb, es->xi);
-  FCM_ALLOC(ctx, nb, es->cell);
-  FCM_ALLOC(ctx, nb, es->elem);
-  FCM_ALLOC(ctx, nb, es->flag);
-  FCM_ALLOC(ctx, 3 * nt, es->tri);
+  es->cap_p = ROOM_POINTS * nb;
+  es->cap_t = ROOM_TRIANGLES * nt;
+  FCM_ALLOC(ctx, 3 * (size_t)es->cap_p, es->X);
+  FCM_ALLOC(ctx, 3 * (size_t)es->cap_p, es->xi);
+  FCM_ALLOC(ctx, es->cap_p, es->cell);
+  FCM_ALLOC(ctx, es->cap_p, es->elem);
+  FCM_ALLOC(ctx, es->cap_p, es->flag);
+  FCM_ALLOC(ctx, 3 * (size_t)es->cap_t, es->tri);
   FCM_ALLOC(ctx, 3 * nt, es->tri0);
   for (fcm_index k = 0; k < 3 * nt; k++)
     es->tri[k] = es->tri0[k] = map[tri[k]];
