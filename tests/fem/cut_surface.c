@@ -13,7 +13,9 @@
  * - the surface set to each cut space (the second reusing what the first cut found in the
  *   cells the second does not reach) has the bits of one made on that space anew: points,
  *   triangles, flags and the displacements of a field.
- * The same for a box cut along cell faces through its boundary vertices.
+ * The same for a box cut along cell faces through its boundary vertices, and for a box of 12
+ * boundary triangles cut by the ball's planes (far more part points and cut faces than
+ * boundary vertices: the surface's arrays grow, in its creation and at each cut).
  * Arguments: tet4 | tet10 | hex8 | hex20. */
 #include "fcm/fcm.h"
 #include "fem_util.h"
@@ -338,6 +340,10 @@ int main(int argc, char **argv)
   const fcm_index gn[3] = {4, 4, 4};
   TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, gn, &g));
   if (g && type != FCM_ELEMENT_COUNT) run(type, g, 2, fp, fn);
+  fcm_geometry_destroy(&g);
+  const fcm_index one[3] = {1, 1, 1};
+  TEST_OK(ctx, fcm_geometry_create_box(ctx, glo, ghi, one, &g));
+  if (g && type != FCM_ELEMENT_COUNT) run(type, g, 2, pp, pn);
   fcm_geometry_destroy(&g);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();

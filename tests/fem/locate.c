@@ -1,8 +1,14 @@
 /* Locating points and interpolating the discrete field, for every element type:
  * located points map back to themselves, a field in the element space is
  * reproduced exactly, and points in inactive cells or outside the mesh are
- * extrapolated from the nearest active cell (exact for linear fields). */
+ * extrapolated from the nearest active cell (exact for linear fields). The same located on a
+ * tree over all the mesh's cells (fcm__space_locate_in(), the embedded surface's) gives the
+ * same cells, xi and flags bit for bit, also for the mesh's nodes (on faces and edges shared
+ * by several cells: the first in cell order). */
+#include "fem/fem_impl.h"
 #include "fem_util.h"
+
+#include <string.h>
 
 static void field(const double x[3], int quadratic, double u[3])
 {
@@ -82,6 +88,40 @@ int main(int argc, char **argv)
     if (in_inactive_region && P[3 * i] > 0.95) TEST_TRUE(ex[i]);
   }
   TEST_TRUE(ex[0] && inside > 100 && outside > 5);
+  { /* on a tree of every cell's node bounds; the points, then the mesh's nodes */
+    double *boxes = malloc(sizeof *boxes * 6 * (size_t)nc), Xc[3 * FCM_ELEMENT_MAX_NODES];
+    for (fcm_index c = 0; c < nc; c++) {
+      double *b = boxes + 6 * c;
+      fcm_mesh_cell_coords(mesh, c, Xc);
+      for (int d = 0; d < 3; d++)
+        b[d] = HUGE_VAL, b[3 + d] = -HUGE_VAL;
+      for (int a = 0; a < info->num_nodes; a++)
+        for (int d = 0; d < 3; d++)
+          b[d] = fmin(b[d], Xc[3 * a + d]), b[3 + d] = fmax(b[3 + d], Xc[3 * a + d]);
+    }
+    fcm_aabb_tree *tree = NULL;
+    TEST_OK(ctx, fcm_aabb_tree_create(ctx, nc, boxes, &tree));
+    for (int pass = 0; pass < 2 && tree; pass++) {
+      const fcm_index n = pass ? nn : NP;
+      const double *Q = pass ? Xn : P;
+      fcm_index *c0 = malloc(sizeof *c0 * (size_t)n), *c1 = malloc(sizeof *c1 * (size_t)n);
+      double *x0 = malloc(sizeof *x0 * 3 * (size_t)n), *x1 = malloc(sizeof *x1 * 3 * (size_t)n);
+      int *e0 = malloc(sizeof *e0 * (size_t)n), *e1 = malloc(sizeof *e1 * (size_t)n);
+      TEST_OK(ctx, fcm_space_locate(space, n, Q, c0, x0, e0));
+      TEST_OK(ctx, fcm__space_locate_in(space, tree, n, Q, c1, x1, e1));
+      TEST_TRUE(!memcmp(c0, c1, sizeof *c0 * (size_t)n));
+      TEST_TRUE(!memcmp(x0, x1, sizeof *x0 * 3 * (size_t)n));
+      TEST_TRUE(!memcmp(e0, e1, sizeof *e0 * (size_t)n));
+      free(c0), free(c1), free(x0), free(x1), free(e0), free(e1);
+    }
+    fcm_aabb_tree_destroy(&tree);
+    /* a tree of other items than the mesh's cells */
+    TEST_OK(ctx, fcm_aabb_tree_create(ctx, nc - 1, boxes, &tree));
+    if (tree)
+      TEST_ERR(ctx, fcm__space_locate_in(space, tree, NP, P, cell, xi, ex), FCM_ERR_ARG, "tree");
+    fcm_aabb_tree_destroy(&tree);
+    free(boxes);
+  }
   cell[3] = -1;
   TEST_ERR(ctx, fcm_space_interpolate(space, NP, cell, xi, u, val), FCM_ERR_ARG, "point 3");
   free(act), free(u), free(P), free(xi), free(val), free(cell), free(ex);

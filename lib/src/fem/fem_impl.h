@@ -392,6 +392,15 @@ void fcm__eliminate_marked(fcm_csr *A, double *b, const unsigned char *con, cons
  * @return FCM_OK, FCM_ERR_ALLOC. (locate.c) */
 fcm_status fcm__space_body_labels(const fcm_space *s, fcm_index *elem_body, fcm_index *num_bodies);
 
+/* fcm_space_locate() with a tree over all the mesh's cells (item c: cell c, its box the bounds
+ * of its nodes, as fcm_aabb_tree_create() got them), of which the space's active cells are
+ * searched: the same cells, xi and flags as fcm_space_locate() (a box query's items come
+ * ascending), without its tree over the active cells. The tree is borrowed.
+ * @return as fcm_space_locate(); FCM_ERR_ARG for a tree of another count of cells or a
+ * space whose elements have other nodes than the mesh's cells. (locate.c) */
+fcm_status fcm__space_locate_in(const fcm_space *s, const fcm_aabb_tree *cells, fcm_index n,
+                                const double *X, fcm_index *cell, double *xi, int *extrapolated);
+
 /* Physical shape-function gradients g (nn x 3) at a point from the reference ones dN (nn x 3)
  * and the nodal coordinates X (nn x 3); returns det J (not positive: g is not written). */
 double fcm__fem_gradients(int nn, const double *X, const double *dN, double *g);
@@ -566,7 +575,10 @@ struct fcm_embedded_surface {
   int32_t *flag;
   fcm_index cap_p, cap_t;
   struct fcm__embed_finder *finder; /* during a rebuild with cuts: the cut cells' pieces */
-  fcm_aabb_tree *cell_tree;         /* from the first rebuild with cuts: the mesh's cells' boxes */
+  /* the mesh's cells' boxes (item c: cell c), made when the surface locates its vertices,
+   * and a millionth of the mesh's largest extent */
+  fcm_aabb_tree *cell_tree;
+  double cell_pad;
   /* What the last rebuild with cuts found, for the next one on rules that extend its rules
    * by further cuts (surface.c: cells no new cut triangle reaches keep their answers):
    * those rules' cut triangles (copied), pieces per cell (piece_off, num cells + 1), the
@@ -577,6 +589,7 @@ struct fcm_embedded_surface {
   fcm_index prev_ntris, prev_ncells;
   double prev_rtol[2]; /* the rules' clip_rtol and sliver_rtol */
   fcm_index *prev_piece_off, *vpiece, *pairs;
+  unsigned char *cross;        /* nbt: whether a cut triangle of those rules crosses triangle t */
   size_t npairs, *poff, *xoff; /* xoff: pair k's first polygon vertex */
   fcm__embed_polys polys;
 };

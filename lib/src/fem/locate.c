@@ -18,27 +18,44 @@ static int inside_reference(fcm_shape shape, const double xi[3], double tol)
 
 enum { MAX_CANDIDATES = 256 };
 
-/* Boxes of the tree overlapping [lo, hi]: into `ids` (MAX_CANDIDATES entries) when they
- * fit, else into *many (allocated here, released by the caller) by a second query sized
- * to the count; *cand points at whichever holds them. */
-static fcm_status query_all(const fcm_space *s, const fcm_aabb_tree *tree, const double lo[3],
+/* The cells a locate searches: the items of a tree over their boxes (the bounds of their
+ * nodes), item k cell tree_cell[k] (tree_cell NULL: cell k), kept when active is NULL or
+ * active[k]; reach: the largest extent of a kept cell's box. */
+typedef struct locator {
+  const fcm_aabb_tree *tree;
+  const fcm_index *tree_cell;
+  const unsigned char *active;
+  double reach;
+} locator;
+
+/* The kept items whose boxes overlap [lo, hi], ascending: into `ids` (MAX_CANDIDATES entries)
+ * when the tree's answer fits, else into *many (allocated here, released by the caller) by a
+ * second query sized to the count; *cand points at whichever holds them. */
+static fcm_status query_all(const fcm_space *s, const locator *L, const double lo[3],
                             const double hi[3], fcm_index *ids, fcm_index **many,
                             const fcm_index **cand, fcm_index *count)
 {
   fcm_status st = FCM_OK;
-  *cand = ids;
-  FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, lo, hi, MAX_CANDIDATES, ids, count));
+  fcm_index *got = ids;
+  FCM_TRY(s->ctx, fcm_aabb_tree_query(L->tree, lo, hi, MAX_CANDIDATES, ids, count));
   if (*count > MAX_CANDIDATES) { /* a crowded box: ids was not written; fetch them all */
     fcm_index want = *count;
     fcm__free(s->ctx, *many);
     *many = NULL;
     FCM_ALLOC(s->ctx, want, *many);
-    FCM_TRY(s->ctx, fcm_aabb_tree_query(tree, lo, hi, want, *many, count));
+    FCM_TRY(s->ctx, fcm_aabb_tree_query(L->tree, lo, hi, want, *many, count));
     FCM_CHECK(*count == want, s->ctx, FCM_ERR_INTERNAL,
               "locate: the box query returned %lld boxes, then %lld", (long long)want,
               (long long)*count);
-    *cand = *many;
+    got = *many;
   }
+  if (L->active) { /* the kept ones, in order */
+    fcm_index m = 0;
+    for (fcm_index k = 0; k < *count; k++)
+      if (L->active[got[k]]) got[m++] = got[k];
+    *count = m;
+  }
+  *cand = got;
 cleanup:
   return st;
 }
@@ -46,10 +63,8 @@ cleanup:
 /* Locate one point: an active cell containing it (the first in the tree's order, the same
  * on every run), else the active cell with the nearest centroid among those near it
  * (extrapolated = 1). */
-static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
-                             const fcm_index *tree_cell, const double *centroid, double reach,
-                             fcm_index i, const double p[3], fcm_index *ids, fcm_index *cell,
-                             double xi[3], int *extrapolated)
+static fcm_status locate_one(const fcm_space *s, const locator *L, fcm_index i, const double p[3],
+                             fcm_index *ids, fcm_index *cell, double xi[3], int *extrapolated)
 {
   fcm_status st = FCM_OK;
   double X[3 * FCM_ELEMENT_MAX_NODES];
@@ -57,9 +72,9 @@ static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
   const fcm_index *cand = NULL;
   const fcm_element_info *info = fcm_element_get_info(s->type);
   fcm_index count = 0;
-  FCM_TRY(s->ctx, query_all(s, tree, p, p, ids, &many, &cand, &count));
+  FCM_TRY(s->ctx, query_all(s, L, p, p, ids, &many, &cand, &count));
   for (fcm_index k = 0; k < count; k++) { /* the first containing cell in the tree's order */
-    fcm_index c = tree_cell[cand[k]];
+    fcm_index c = L->tree_cell ? L->tree_cell[cand[k]] : cand[k];
     fcm_mesh_cell_coords(s->mesh, c, X);
     if (fcm_element_inverse_map(NULL, s->type, X, p, xi) == FCM_OK &&
         inside_reference(info->shape, xi, 1e-10)) {
@@ -69,20 +84,23 @@ static fcm_status locate_one(const fcm_space *s, const fcm_aabb_tree *tree,
     }
   }
   /* not inside any active cell: the nearest centroid within a growing box */
-  for (double r = reach;; r *= 2.0) {
+  for (double r = L->reach;; r *= 2.0) {
     double lo[3] = {p[0] - r, p[1] - r, p[2] - r}, hi[3] = {p[0] + r, p[1] + r, p[2] + r};
-    FCM_TRY(s->ctx, query_all(s, tree, lo, hi, ids, &many, &cand, &count));
-    if (count == 0 && r < 1e6 * reach) continue;
+    FCM_TRY(s->ctx, query_all(s, L, lo, hi, ids, &many, &cand, &count));
+    if (count == 0 && r < 1e6 * L->reach) continue;
     FCM_CHECK(count > 0, s->ctx, FCM_ERR_GEOMETRY,
               "locate: point %lld (%g, %g, %g) has no active cell within %g of it", (long long)i,
               p[0], p[1], p[2], r);
     double best = HUGE_VAL;
     *cell = -1;
     for (fcm_index k = 0; k < count; k++) {
-      const double *cc = centroid + 3 * cand[k];
+      const double *b = L->tree->boxes + 6 * cand[k];
+      double cc[3];
+      for (int d = 0; d < 3; d++)
+        cc[d] = 0.5 * (b[d] + b[3 + d]);
       double d = (cc[0] - p[0]) * (cc[0] - p[0]) + (cc[1] - p[1]) * (cc[1] - p[1]) +
                  (cc[2] - p[2]) * (cc[2] - p[2]);
-      if (d < best) best = d, *cell = tree_cell[cand[k]];
+      if (d < best) best = d, *cell = L->tree_cell ? L->tree_cell[cand[k]] : cand[k];
     }
     break;
   }
@@ -116,24 +134,52 @@ cleanup:
   return st;
 }
 
+/* Locate the n points X with L (fcm_space_locate()). */
+static fcm_status locate_points(const fcm_space *s, const locator *L, fcm_index n, const double *X,
+                                fcm_index *cell, double *xi, int *extrapolated)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  fcm_index *ids = NULL;
+  const int nthreads = fcm_ctx_num_threads(ctx);
+  FCM_ALLOC(ctx, (size_t)MAX_CANDIDATES * nthreads, ids);
+  fcm__loop loop; /* an error is recorded once: the lowest failing point's */
+  fcm__loop_begin(ctx, &loop);
+#pragma omp parallel num_threads(nthreads)
+  {
+    fcm_index *my_ids = ids + (size_t)MAX_CANDIDATES * omp_get_thread_num();
+#pragma omp for schedule(dynamic, 64)
+    for (fcm_index i = 0; i < n; i++) {
+      int ex = 0;
+      if (fcm__loop_skip(&loop, i)) continue;
+      fcm__loop_iter it;
+      fcm__loop_enter(&loop, &it, i);
+      fcm_status si = locate_one(s, L, i, X + 3 * i, my_ids, cell + i, xi + 3 * i, &ex);
+      fcm__loop_leave(&loop, &it, si);
+      if (si == FCM_OK && extrapolated) extrapolated[i] = ex;
+    }
+  }
+  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+cleanup:
+  fcm__free(ctx, ids);
+  return st;
+}
+
 fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fcm_index *cell,
                             double *xi, int *extrapolated)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = s->ctx;
   fcm_aabb_tree *tree = NULL;
-  double *boxes = NULL, *centroid = NULL;
-  fcm_index *tree_cell = NULL, *ids = NULL, nact = 0;
-  double reach = 0.0;
-  const int nthreads = fcm_ctx_num_threads(ctx);
+  double *boxes = NULL;
+  fcm_index *tree_cell = NULL, nact = 0;
+  locator L = {NULL, NULL, NULL, 0.0};
   FCM_CHECK(n >= 0 && (n == 0 || (X && cell && xi)), ctx, FCM_ERR_ARG,
             "locate: n = %lld with NULL arrays", (long long)n);
   for (fcm_index c = 0; c < s->num_cells; c++)
     nact += s->active[c];
   FCM_ALLOC(ctx, 6 * nact, boxes);
-  FCM_ALLOC(ctx, 3 * nact, centroid);
   FCM_ALLOC(ctx, nact, tree_cell);
-  FCM_ALLOC(ctx, (size_t)MAX_CANDIDATES * nthreads, ids);
   {
     double Xc[3 * FCM_ELEMENT_MAX_NODES];
     fcm_index k = 0;
@@ -148,38 +194,39 @@ fcm_status fcm_space_locate(const fcm_space *s, fcm_index n, const double *X, fc
           b[d] = fmin(b[d], Xc[3 * a + d]);
           b[3 + d] = fmax(b[3 + d], Xc[3 * a + d]);
         }
-      for (int d = 0; d < 3; d++) {
-        centroid[3 * k + d] = 0.5 * (b[d] + b[3 + d]);
-        reach = fmax(reach, b[3 + d] - b[d]);
-      }
+      for (int d = 0; d < 3; d++)
+        L.reach = fmax(L.reach, b[3 + d] - b[d]);
       tree_cell[k++] = c;
     }
   }
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nact, boxes, &tree));
-  fcm__loop loop; /* an error is recorded once: the lowest failing point's */
-  fcm__loop_begin(ctx, &loop);
-#pragma omp parallel num_threads(nthreads)
-  {
-    fcm_index *my_ids = ids + (size_t)MAX_CANDIDATES * omp_get_thread_num();
-#pragma omp for schedule(dynamic, 64)
-    for (fcm_index i = 0; i < n; i++) {
-      int ex = 0;
-      if (fcm__loop_skip(&loop, i)) continue;
-      fcm__loop_iter it;
-      fcm__loop_enter(&loop, &it, i);
-      fcm_status si = locate_one(s, tree, tree_cell, centroid, reach, i, X + 3 * i, my_ids,
-                                 cell + i, xi + 3 * i, &ex);
-      fcm__loop_leave(&loop, &it, si);
-      if (si == FCM_OK && extrapolated) extrapolated[i] = ex;
-    }
-  }
-  FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
+  L.tree = tree, L.tree_cell = tree_cell;
+  FCM_TRY(ctx, locate_points(s, &L, n, X, cell, xi, extrapolated));
 cleanup:
   fcm_aabb_tree_destroy(&tree);
   fcm__free(ctx, boxes);
-  fcm__free(ctx, centroid);
   fcm__free(ctx, tree_cell);
-  fcm__free(ctx, ids);
+  return st;
+}
+
+fcm_status fcm__space_locate_in(const fcm_space *s, const fcm_aabb_tree *cells, fcm_index n,
+                                const double *X, fcm_index *cell, double *xi, int *extrapolated)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  locator L = {cells, NULL, s->active, 0.0};
+  FCM_CHECK(n >= 0 && (n == 0 || (X && cell && xi)), ctx, FCM_ERR_ARG,
+            "locate: n = %lld with NULL arrays", (long long)n);
+  FCM_CHECK(cells && cells->num_items == s->num_cells && s->nn == fcm_mesh_nodes_per_cell(s->mesh),
+            ctx, FCM_ERR_ARG, "locate: the cells' tree is not one of the space's mesh cells");
+  for (fcm_index c = 0; c < s->num_cells; c++) {
+    if (!s->active[c]) continue;
+    const double *b = cells->boxes + 6 * c;
+    for (int d = 0; d < 3; d++)
+      L.reach = fmax(L.reach, b[3 + d] - b[d]);
+  }
+  FCM_TRY(ctx, locate_points(s, &L, n, X, cell, xi, extrapolated));
+cleanup:
   return st;
 }
 

@@ -16,6 +16,12 @@
  * triangle partly outside the mesh) it is kept whole. */
 #define SPLIT_AREA_RTOL 1e-9
 
+/* Points and triangles a surface is made with room for, per boundary vertex and triangle
+ * (surface_reserve()): Dick's Bunny 2 holds 2.8 points and 1.3 triangles per boundary vertex
+ * and triangle after its four cuts. */
+#define ROOM_POINTS    3
+#define ROOM_TRIANGLES 2
+
 /* The element of cell c integrating rules piece p; -1 when none does. */
 static fcm_index piece_element(const fcm_space *s, fcm_index c, fcm_index p)
 {
@@ -50,7 +56,7 @@ static void tri_coords(const fcm_embedded_surface *es, fcm_index t, double x[9])
     memcpy(x + 3 * a, es->X + 3 * es->tri0[3 * t + a], 3 * sizeof *x);
 }
 
-/* The search tree of the mesh's cells. */
+/* The search tree of the mesh's cells, and a millionth of the mesh's size. */
 static fcm_status cell_tree(fcm_embedded_surface *es)
 {
   fcm_status st = FCM_OK;
@@ -70,6 +76,13 @@ static fcm_status cell_tree(fcm_embedded_surface *es)
         b[d] = fmin(b[d], X[3 * a + d]), b[3 + d] = fmax(b[3 + d], X[3 * a + d]);
   }
   FCM_TRY(ctx, fcm_aabb_tree_create(ctx, nc, boxes, &es->cell_tree));
+  double mlo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, mhi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  const fcm_index nn = fcm_mesh_num_nodes(es->mesh);
+  const double *mx = fcm_mesh_coords(es->mesh);
+  for (fcm_index i = 0; i < nn; i++)
+    for (int d = 0; d < 3; d++)
+      mlo[d] = fmin(mlo[d], mx[3 * i + d]), mhi[d] = fmax(mhi[d], mx[3 * i + d]);
+  es->cell_pad = 1e-6 * fmax(mhi[0] - mlo[0], fmax(mhi[1] - mlo[1], mhi[2] - mlo[2]));
 cleanup:
   fcm__free(ctx, boxes);
   return st;
@@ -87,8 +100,8 @@ static fcm_index map_piece(const fcm_embedded_surface *es, fcm_index c, fcm_inde
  * same cells), cell c has as many pieces, each the child of the one in its place, and no
  * new cut triangle's box comes within a millionth of the mesh's size of the cell's box (the
  * finder takes the cut triangles within 2e-9 of a cell's size), with the same tolerances of
- * the parts. All 1 otherwise. */
-static fcm_status changed_cells(fcm_embedded_surface *es, unsigned char *changed)
+ * the parts. All 1 otherwise; *extends_out: whether the rules extend that rebuild's. */
+static fcm_status changed_cells(fcm_embedded_surface *es, unsigned char *changed, int *extends_out)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
@@ -100,6 +113,7 @@ static fcm_status changed_cells(fcm_embedded_surface *es, unsigned char *changed
       R->opts.clip_rtol == es->prev_rtol[0] && R->opts.sliver_rtol == es->prev_rtol[1] &&
       R->num_cut_tris >= es->prev_ntris &&
       !memcmp(R->cut_tris, es->prev_tris, (size_t)es->prev_ntris * sizeof *R->cut_tris);
+  *extends_out = extends;
   for (fcm_index c = 0; c < nc; c++) {
     const fcm_index p0 = R->piece_off[c], n = R->piece_off[c + 1] - p0;
     changed[c] = !extends || n != es->prev_piece_off[c + 1] - es->prev_piece_off[c];
@@ -108,13 +122,7 @@ static fcm_status changed_cells(fcm_embedded_surface *es, unsigned char *changed
   }
   if (!extends) return FCM_OK;
   FCM_TRY(ctx, cell_tree(es));
-  double mlo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, mhi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  const fcm_index nn = fcm_mesh_num_nodes(es->mesh);
-  const double *mx = fcm_mesh_coords(es->mesh);
-  for (fcm_index i = 0; i < nn; i++)
-    for (int d = 0; d < 3; d++)
-      mlo[d] = fmin(mlo[d], mx[3 * i + d]), mhi[d] = fmax(mhi[d], mx[3 * i + d]);
-  const double w = 1e-6 * fmax(mhi[0] - mlo[0], fmax(mhi[1] - mlo[1], mhi[2] - mlo[2]));
+  const double w = es->cell_pad;
   for (fcm_index t = es->prev_ntris; t < R->num_cut_tris; t++) {
     double lo[3], hi[3];
     for (int d = 0; d < 3; d++)
@@ -131,12 +139,14 @@ cleanup:
 /* Forget what the last rebuild with cuts found. */
 static void cache_clear(fcm_embedded_surface *es)
 {
-  void *arrays[] = {es->prev_tris, es->prev_piece_off, es->vpiece, es->pairs, es->poff, es->xoff};
+  void *arrays[] = {es->prev_tris, es->prev_piece_off, es->vpiece, es->pairs,
+                    es->poff,      es->xoff,           es->cross};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(es->ctx, arrays[k]);
   fcm__embed_polys_free(es->ctx, &es->polys);
   es->prev_tris = NULL, es->prev_piece_off = es->vpiece = es->pairs = NULL;
   es->poff = es->xoff = NULL;
+  es->cross = NULL;
   es->prev_ntris = es->prev_ncells = 0;
   es->npairs = 0;
 }
@@ -307,12 +317,60 @@ cleanup:
   return st;
 }
 
+/* split[t] (nbt): whether a cut triangle crosses boundary triangle t (fcm__embed_finder_crosses()),
+ * kept in es->cross. On rules that extend the last rebuild's (extends), whose cut triangles
+ * answer as they did, only the triangles whose boxes come within es->cell_pad of a new cut
+ * triangle's are tested again (the finder's tolerance is 2e-9 of a cell's size, the pad a
+ * millionth of the mesh's): the others keep es->cross. */
+static fcm_status cut_crossings(fcm_embedded_surface *es, int extends, unsigned char *split)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  const fcm_cell_rules *R = es->space->rules;
+  const fcm_aabb_tree *tris = NULL;
+  fcm__idbuf ids = {NULL, 0, 0};
+  unsigned char *again = NULL;
+  if (extends && es->cross) {
+    FCM_TRY(ctx, fcm__geom_tree(ctx, es->geom, 1, &tris));
+    FCM_CHECK(tris->num_items == es->nbt, ctx, FCM_ERR_INTERNAL,
+              "embedded surface: %lld boundary triangles in the geometry's tree, %lld here",
+              (long long)tris->num_items, (long long)es->nbt);
+    FCM_ALLOC(ctx, (size_t)es->nbt + 1, again);
+    const double w = es->cell_pad;
+    for (fcm_index c = es->prev_ntris; c < R->num_cut_tris; c++) {
+      double lo[3], hi[3];
+      for (int d = 0; d < 3; d++)
+        lo[d] = R->cut_tris[c].lo[d] - w, hi[d] = R->cut_tris[c].hi[d] + w;
+      FCM_TRY(ctx, fcm__geom_tree_query(ctx, tris, lo, hi, &ids));
+      for (size_t k = 0; k < ids.n; k++)
+        again[ids.ids[k]] = 1;
+    }
+  }
+  for (fcm_index t = 0; t < es->nbt; t++) {
+    if (again && !again[t]) {
+      split[t] = es->cross[t];
+      continue;
+    }
+    double x[9];
+    int crosses;
+    tri_coords(es, t, x);
+    FCM_TRY(ctx, fcm__embed_finder_crosses(es->finder, x, &crosses));
+    split[t] = (unsigned char)crosses;
+  }
+  if (!es->cross) FCM_ALLOC_RAW(ctx, (size_t)es->nbt + 1, es->cross);
+  memcpy(es->cross, split, (size_t)es->nbt);
+cleanup:
+  fcm__free(ctx, again);
+  fcm__geom_idbuf_free(ctx, &ids);
+  return st;
+}
+
 /* The pieces of the boundary vertices in cells that cuts split (es->elem), and which boundary
  * triangles to split: those a cut crosses and those with a vertex on a cut (parts of two
  * pieces hold it: each triangle then takes its side). split: nbt flags. While a cell's parts
  * are at hand, the triangles split_triangles() may clip in it are clipped into *pc (a cell's
  * parts cost far more than the clipping). */
-static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *changed,
+static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *changed, int extends,
                              unsigned char *split, preclip *pc)
 {
   fcm_status st = FCM_OK;
@@ -340,13 +398,7 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
     pairs[2 * n] = c, pairs[2 * n + 1] = i, n++;
     maybe[i] = qcell[c] = 1;
   }
-  for (fcm_index t = 0; t < es->nbt; t++) { /* the cuts' triangles alone decide */
-    double x[9];
-    int crosses;
-    tri_coords(es, t, x);
-    FCM_TRY(ctx, fcm__embed_finder_crosses(f, x, &crosses));
-    split[t] = (unsigned char)crosses;
-  }
+  FCM_TRY(ctx, cut_crossings(es, extends, split)); /* the cuts' triangles alone decide */
   FCM_TRY(ctx, preclip_pairs(es, split, maybe, qcell, pc));
   qsort(pairs, (size_t)n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
   size_t kc = 0;
@@ -474,25 +526,60 @@ cleanup:
   return st;
 }
 
-/* Room for np points and nt triangles. */
+/* *a (n_old x size, its first keep in use) as a new array of n: the rest not zeroed (written
+ * before it is read), so that only the pages written are touched. */
+static fcm_status grow(fcm_ctx *ctx, void **a, size_t keep, size_t n, size_t size)
+{
+  fcm_status st = FCM_OK;
+  void *fresh = fcm__malloc(ctx, n, size); /* reports the failure */
+  if (!fresh) {
+    st = FCM_ERR_ALLOC;
+    fcm__trace(ctx, __FILE__, __LINE__, __func__);
+    goto cleanup;
+  }
+  memcpy(fresh, *a, keep * size);
+  fcm__free(ctx, *a);
+  *a = fresh;
+cleanup:
+  return st;
+}
+
+/* Room for np points and nt triangles, the current ones kept: twice as much when it grows.
+ * The surface is made with room for its first cuts (ROOM_POINTS, ROOM_TRIANGLES): a cut then
+ * writes the parts and cut faces into pages already in memory, where a grown array's pages
+ * would be faulted in again (a few ms at 100k points). */
 static fcm_status surface_reserve(fcm_embedded_surface *es, fcm_index np, fcm_index nt)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
   if (np > es->cap_p) {
-    const size_t old = (size_t)es->cap_p;
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->X, 3 * old, 3 * (size_t)np, sizeof(double)));
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->xi, 3 * old, 3 * (size_t)np, sizeof(double)));
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->cell, old, (size_t)np, sizeof(fcm_index)));
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->elem, old, (size_t)np, sizeof(fcm_index)));
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->flag, old, (size_t)np, sizeof(int32_t)));
-    es->cap_p = np;
+    const size_t n = (size_t)FCM_MAX(np, 2 * es->cap_p), keep = (size_t)FCM_MAX(es->np, es->nb);
+    FCM_TRY(ctx, grow(ctx, (void **)&es->X, 3 * keep, 3 * n, sizeof(double)));
+    FCM_TRY(ctx, grow(ctx, (void **)&es->xi, 3 * keep, 3 * n, sizeof(double)));
+    FCM_TRY(ctx, grow(ctx, (void **)&es->cell, keep, n, sizeof(fcm_index)));
+    FCM_TRY(ctx, grow(ctx, (void **)&es->elem, keep, n, sizeof(fcm_index)));
+    FCM_TRY(ctx, grow(ctx, (void **)&es->flag, keep, n, sizeof(int32_t)));
+    es->cap_p = (fcm_index)n;
   }
   if (nt > es->cap_t) {
-    FCM_TRY(ctx, fcm__resize(ctx, (void **)&es->tri, 3 * (size_t)es->cap_t, 3 * (size_t)nt,
-                             sizeof(fcm_index)));
-    es->cap_t = nt;
+    const size_t n = (size_t)FCM_MAX(nt, 2 * es->cap_t);
+    FCM_TRY(ctx, grow(ctx, (void **)&es->tri, 3 * (size_t)es->nt, 3 * n, sizeof(fcm_index)));
+    es->cap_t = (fcm_index)n;
   }
+cleanup:
+  return st;
+}
+
+/* fcm_space_locate() of the n points X in the current space, on the cells' tree. */
+static fcm_status locate(fcm_embedded_surface *es, fcm_index n, const double *X, fcm_index *cell,
+                         double *xi)
+{
+  const fcm_space *s = es->space;
+  if (s->nn != fcm_mesh_nodes_per_cell(es->mesh)) /* other boxes than the tree's */
+    return fcm_space_locate(s, n, X, cell, xi, NULL);
+  fcm_status st = FCM_OK;
+  FCM_TRY(es->ctx, cell_tree(es));
+  FCM_TRY(es->ctx, fcm__space_locate_in(s, es->cell_tree, n, X, cell, xi, NULL));
 cleanup:
   return st;
 }
@@ -529,7 +616,7 @@ static fcm_status part_points(fcm_embedded_surface *es, fcm_index v, fcm_index n
     FCM_ALLOC_RAW(ctx, (size_t)nlost, lc);
     for (fcm_index k = 0; k < nlost; k++)
       memcpy(lx + 3 * k, es->X + 3 * lost[k], 3 * sizeof *lx);
-    FCM_TRY(ctx, fcm_space_locate(s, nlost, lx, lc, lxi, NULL));
+    FCM_TRY(ctx, locate(es, nlost, lx, lc, lxi));
     for (fcm_index k = 0; k < nlost; k++) {
       const fcm_index i = lost[k];
       es->cell[i] = lc[k];
@@ -557,7 +644,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   unsigned char *split = NULL, *changed = NULL;
   fcm__embed_polys polys = {NULL, NULL, NULL, 0, 0, 0, 0};
   preclip pre;
-  fcm_index *src = NULL, *pcell = NULL, *order = NULL, *ppiece = NULL;
+  fcm_index *src = NULL, *pcell = NULL, *order = NULL, *ppiece = NULL, *by_tri = NULL;
   memset(&pre, 0, sizeof pre);
   size_t *first_x = NULL;
   fcm_index ncf = 0;
@@ -576,8 +663,9 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
     if (!es->finder) FCM_TRY(ctx, fcm__embed_finder_create(ctx, es->mesh, es->geom, &es->finder));
     FCM_TRY(ctx, fcm__embed_finder_set_rules(es->finder, rules));
     FCM_ALLOC_RAW(ctx, (size_t)rules->num_cells + 1, changed);
-    FCM_TRY(ctx, changed_cells(es, changed));
-    FCM_TRY(ctx, mark_split(es, changed, split, &pre));
+    int extends = 0;
+    FCM_TRY(ctx, changed_cells(es, changed, &extends));
+    FCM_TRY(ctx, mark_split(es, changed, extends, split, &pre));
     FCM_TRY(ctx, split_triangles(es, changed, &pre, split, &polys, &src, &pcell));
     FCM_TRY(ctx, cache_rules(es));
   } else {
@@ -596,13 +684,13 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
     nsv += polys.nv[j];
     nst += polys.nv[j] - 2;
   }
-  for (fcm_index k = 1; k < nkeep; k++) { /* insertion sort by triangle: stable, nearly sorted */
-    const fcm_index j = order[k];
-    fcm_index m = k;
-    while (m > 0 && src[order[m - 1]] > src[j])
-      order[m] = order[m - 1], m--;
-    order[m] = j;
-  }
+  /* by triangle, stably: the parts come in cell order, far from the triangles' */
+  FCM_ALLOC_RAW(ctx, 2 * (size_t)nkeep + 2, by_tri);
+  for (fcm_index k = 0; k < nkeep; k++)
+    by_tri[2 * k] = src[order[k]], by_tri[2 * k + 1] = order[k];
+  if (nkeep > 1) qsort(by_tri, (size_t)nkeep, 2 * sizeof *by_tri, cmp_pair);
+  for (fcm_index k = 0; k < nkeep; k++)
+    order[k] = by_tri[2 * k + 1];
   const fcm_index np = es->nb + nsv + 3 * ncf, nt = es->nbt - nsplit + nst + ncf;
   FCM_TRY(ctx, surface_reserve(es, np, nt));
   fcm_index v = es->nb, t = 0;
@@ -657,6 +745,7 @@ cleanup:
   fcm__free(ctx, src);
   fcm__free(ctx, pcell);
   fcm__free(ctx, order);
+  fcm__free(ctx, by_tri);
   fcm__free(ctx, first_x);
   fcm__free(ctx, ppiece);
   fcm__embed_polys_free(ctx, &polys);
@@ -688,14 +777,14 @@ fcm_status fcm_embedded_surface_create(const fcm_space *s, const fcm_geometry *g
   fcm_index nb = 0;
   for (fcm_index k = 0; k < 3 * nt; k++)
     if (map[tri[k]] < 0) map[tri[k]] = nb++;
-  es->cap_p = nb;
-  es->cap_t = nt;
-  FCM_ALLOC(ctx, 3 * nb, es->X);
-  FCM_ALLOC(ctx, 3 * nb, es->xi);
-  FCM_ALLOC(ctx, nb, es->cell);
-  FCM_ALLOC(ctx, nb, es->elem);
-  FCM_ALLOC(ctx, nb, es->flag);
-  FCM_ALLOC(ctx, 3 * nt, es->tri);
+  es->cap_p = ROOM_POINTS * nb;
+  es->cap_t = ROOM_TRIANGLES * nt;
+  FCM_ALLOC(ctx, 3 * (size_t)es->cap_p, es->X);
+  FCM_ALLOC(ctx, 3 * (size_t)es->cap_p, es->xi);
+  FCM_ALLOC(ctx, es->cap_p, es->cell);
+  FCM_ALLOC(ctx, es->cap_p, es->elem);
+  FCM_ALLOC(ctx, es->cap_p, es->flag);
+  FCM_ALLOC(ctx, 3 * (size_t)es->cap_t, es->tri);
   FCM_ALLOC(ctx, 3 * nt, es->tri0);
   for (fcm_index k = 0; k < 3 * nt; k++)
     es->tri[k] = es->tri0[k] = map[tri[k]];
@@ -703,7 +792,7 @@ fcm_status fcm_embedded_surface_create(const fcm_space *s, const fcm_geometry *g
     if (map[i] >= 0) memcpy(es->X + 3 * map[i], GX + 3 * i, 3 * sizeof(double));
   es->nb = nb;
   es->nbt = nt;
-  FCM_TRY(ctx, fcm_space_locate(s, nb, es->X, es->cell, es->xi, NULL));
+  FCM_TRY(ctx, locate(es, nb, es->X, es->cell, es->xi));
   FCM_TRY(ctx, surface_rebuild(es));
   *out = es;
   es = NULL;
