@@ -779,12 +779,19 @@ fcm_status fcm_embedded_surface_create(const fcm_space *s, const fcm_geometry *g
     if (map[tri[k]] < 0) map[tri[k]] = nb++;
   es->cap_p = ROOM_POINTS * nb;
   es->cap_t = ROOM_TRIANGLES * nt;
-  FCM_ALLOC(ctx, 3 * (size_t)es->cap_p, es->X);
-  FCM_ALLOC(ctx, 3 * (size_t)es->cap_p, es->xi);
-  FCM_ALLOC(ctx, es->cap_p, es->cell);
-  FCM_ALLOC(ctx, es->cap_p, es->elem);
-  FCM_ALLOC(ctx, es->cap_p, es->flag);
-  FCM_ALLOC(ctx, 3 * (size_t)es->cap_t, es->tri);
+  /* the room beyond the boundary's points is written before it is read (raw: a surface that
+   * is never cut does not touch its pages) */
+  FCM_ALLOC_RAW(ctx, 3 * (size_t)es->cap_p, es->X);
+  FCM_ALLOC_RAW(ctx, 3 * (size_t)es->cap_p, es->xi);
+  FCM_ALLOC_RAW(ctx, es->cap_p, es->cell);
+  FCM_ALLOC_RAW(ctx, es->cap_p, es->elem);
+  FCM_ALLOC_RAW(ctx, es->cap_p, es->flag);
+  FCM_ALLOC_RAW(ctx, 3 * (size_t)es->cap_t, es->tri);
+  memset(es->X, 0, 3 * (size_t)nb * sizeof *es->X);
+  memset(es->xi, 0, 3 * (size_t)nb * sizeof *es->xi);
+  memset(es->cell, 0, (size_t)nb * sizeof *es->cell);
+  memset(es->elem, 0, (size_t)nb * sizeof *es->elem);
+  memset(es->flag, 0, (size_t)nb * sizeof *es->flag);
   FCM_ALLOC(ctx, 3 * nt, es->tri0);
   for (fcm_index k = 0; k < 3 * nt; k++)
     es->tri[k] = es->tri0[k] = map[tri[k]];

@@ -500,7 +500,9 @@ static fcm_index kept_row(const fcm_space *from, cut_map *m, fcm_index k, fcm_in
   return cnt;
 }
 
-/* The rows are made by the threads, each with its own marks (mark: nt arrays of ncopy). */
+/* The rows are made by the threads, each with its own marks (mark: nt arrays of ncopy, a
+ * thread's set to -1 when it first makes a row that is not kept: untouched, its pages cost
+ * nothing). */
 static fcm_status node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index *cptr,
                              const fcm_index *cinc, const fcm_space *from, cut_map *m)
 {
@@ -515,8 +517,7 @@ static fcm_status node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index
 #pragma omp parallel num_threads(nt) reduction(min : bad) reduction(+ : kept_rows)
     {
       fcm_index *mk = mark + (size_t)omp_get_thread_num() * (size_t)(ncopy + 1);
-      for (fcm_index k = 0; k < ncopy; k++)
-        mk[k] = -1;
+      int marks_set = 0;
 #pragma omp for schedule(dynamic, 256)
       for (fcm_index k = 0; k < ncopy; k++) {
         fcm_index *row = pass ? s->node_adj + s->node_ptr[k] : NULL, cnt;
@@ -528,6 +529,11 @@ static fcm_status node_graph(fcm_space *s, const fcm_index *g2l, const fcm_index
           }
           kept_rows += pass;
         } else {
+          if (!marks_set) {
+            for (fcm_index j = 0; j < ncopy; j++)
+              mk[j] = -1;
+            marks_set = 1;
+          }
           cnt = copy_row(s, g2l, cptr, cinc, k, mk, row);
         }
         if (!pass) s->node_ptr[k + 1] = cnt;
