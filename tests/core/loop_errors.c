@@ -2,7 +2,8 @@
  * error reported is the one of the lowest failing iteration, with its own message,
  * status and traceback, recorded once; an iteration that handles an error of its own and
  * returns FCM_OK leaves nothing; a loop nested in an iteration reports into it; an
- * iteration failing without a message gets a generic one naming it. */
+ * iteration failing without a message gets a generic one naming it; a prefix added inside a
+ * failing iteration (fcm__error_prefix()) stays on the message the loop reports. */
 #include "core/core_impl.h"
 #include "test.h"
 
@@ -55,6 +56,26 @@ cleanup:
   return st;
 }
 
+/* The loop of outer() whose iterations prefix their own errors. */
+static fcm_status prefixed(fcm_ctx *ctx, const fcm_index *fail, int nfail)
+{
+  fcm_status st = FCM_OK;
+  fcm__loop L;
+  fcm__loop_begin(ctx, &L);
+#pragma omp parallel for schedule(dynamic, 3)
+  for (fcm_index i = 0; i < 1000; i++) {
+    if (fcm__loop_skip(&L, i)) continue;
+    fcm__loop_iter it;
+    fcm__loop_enter(&L, &it, i);
+    const fcm_status s = work(ctx, i, fail, nfail, 0);
+    if (s != FCM_OK) fcm__error_prefix(ctx, "part");
+    fcm__loop_leave(&L, &it, s);
+  }
+  FCM_TRY(ctx, fcm__loop_end(&L, NULL));
+cleanup:
+  return st;
+}
+
 /* A loop whose iteration 5 runs an inner loop failing at its iterations 9 and 4. */
 static fcm_status nested(fcm_ctx *ctx)
 {
@@ -99,7 +120,12 @@ int main(void)
              "iteration 300 of a parallel loop failed");
     /* nested: the inner loop's lowest failure, reported through the outer iteration */
     TEST_ERR(ctx, nested(ctx), FCM_ERR_ARG, "iteration 4 failed");
+    TEST_ERR(ctx, prefixed(ctx, fail, 4), FCM_ERR_ARG, "part: iteration 300 failed");
   }
+  /* outside a loop the context's message takes the prefix */
+  TEST_TRUE(outer(ctx, 1000, fail, 4, 0, NULL) == FCM_ERR_ARG);
+  fcm__error_prefix(ctx, "run");
+  TEST_TRUE(strncmp(fcm_ctx_error_message(ctx), "run: iteration 300 failed", 25) == 0);
   /* the traceback: the FCM_CHECK frame first, then the frames of the callers */
   TEST_TRUE(outer(ctx, 1000, fail, 4, 0, NULL) == FCM_ERR_ARG);
   char buf[4096] = {0};

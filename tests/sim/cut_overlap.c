@@ -14,8 +14,10 @@
  * create the same number of hierarchies. With "fail" (multigrid) the second cut fails at an
  * allocation spread over the cut's allocations (the allocator counts atomically: the parts
  * allocate side by side), with the parts in turn and side by side: the run goes on with the
- * integrator it had (its storage given back), steps to the end and leaks nothing.
- * Usage: sim_cut_overlap <element> [threads | multigrid | fail] */
+ * integrator it had (its storage given back), steps to the end and leaks nothing. With
+ * "nosurface" (multigrid) the scene writes no output surface: the values and the structure
+ * still go side by side.
+ * Usage: sim_cut_overlap <element> [threads | multigrid | fail | nosurface] */
 #include "fcm/fcm.h"
 #include "scene/run_impl.h"
 #include "fem/fem_impl.h"
@@ -48,7 +50,8 @@ static int same_bits(const void *a, const void *b, size_t bytes)
   return memcmp(a, b, bytes) == 0;
 }
 
-static void scene_json(char *buf, size_t cap, const char *element, int threads, int multigrid)
+static void scene_json(char *buf, size_t cap, const char *element, int threads, int multigrid,
+                       int surface)
 {
   snprintf(
       buf, cap,
@@ -60,7 +63,7 @@ static void scene_json(char *buf, size_t cap, const char *element, int threads, 
       " \"material\": {\"model\": \"%s\", \"young\": 1e5, \"poisson\": 0.3, \"density\": 1000},"
       " \"solver\": {\"threads\": %d%s},"
       " \"time\": {\"dt\": 0.02, \"steps\": 6},"
-      " \"output\": {\"background\": false},"
+      " \"output\": {\"background\": false, \"surface\": %s},"
       " \"effects\": [{\"initial_velocity\": {\"angular_velocity\": [0, 0, 4]}},"
       "  {\"cut\": {\"time\": 0.02, \"surface\": {\"plane\": {\"point\": [0.43, 0.25, 0.25],"
       "     \"normal\": [1, 0.1, 0]}}}},"
@@ -71,7 +74,8 @@ static void scene_json(char *buf, size_t cap, const char *element, int threads, 
       element, multigrid ? "corotated_linear" : "snh", threads,
       multigrid ? ", \"method\": \"multigrid\", \"fixed_cycles\": 3,"
                   " \"multigrid\": {\"coarse_dofs\": 20}, \"newton\": {\"fixed_iterations\": 1}"
-                : "");
+                : "",
+      surface ? "true" : "false");
 }
 
 /* After a cut: the integrator's hierarchy is the structure of the active set its state
@@ -98,7 +102,7 @@ static int cut_failing(const char *element, int in_turn, long long k, long long 
   char json[4096];
   int failed = 0;
   TEST_OK(NULL, fcm_ctx_create(&o, &ctx));
-  scene_json(json, sizeof json, element, 2, 1);
+  scene_json(json, sizeof json, element, 2, 1, 1);
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "cut_overlap.json", &scene));
   if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
   if (!sim) goto done;
@@ -160,7 +164,8 @@ int main(int argc, char **argv)
 {
   const char *element = argc > 1 ? argv[1] : "hex8";
   const int threads_mode = argc > 2 && !strcmp(argv[2], "threads");
-  const int multigrid = argc > 2 && !strcmp(argv[2], "multigrid");
+  const int nosurface = argc > 2 && !strcmp(argv[2], "nosurface");
+  const int multigrid = argc > 2 && (!strcmp(argv[2], "multigrid") || nosurface);
   if (argc > 2 && !strcmp(argv[2], "fail")) return fail_main(element);
   if (threads_mode) fcm_blas_set_num_threads(2);
   fcm_ctx *ctx[2] = {NULL, NULL};
@@ -169,7 +174,7 @@ int main(int argc, char **argv)
   char json[4096];
   for (int r = 0; r < 2; r++) {
     TEST_OK(NULL, fcm_ctx_create(NULL, &ctx[r]));
-    scene_json(json, sizeof json, element, threads_mode ? r + 1 : 2, multigrid);
+    scene_json(json, sizeof json, element, threads_mode ? r + 1 : 2, multigrid, !nosurface);
     TEST_OK(ctx[r], fcm_scene_create_from_string(ctx[r], json, "cut_overlap.json", &scene[r]));
     if (scene[r]) TEST_OK(ctx[r], fcm_simulation_create(ctx[r], scene[r], NULL, &sim[r]));
   }
@@ -203,7 +208,9 @@ int main(int argc, char **argv)
     TEST_TRUE(same_bits(q[0], q[1], sizeof q[0]));
   }
   TEST_TRUE(fcm_simulation_done(sim[0]) && fcm_simulation_done(sim[1]));
-  {
+  if (nosurface) {
+    TEST_TRUE(!sim[0]->surf && !sim[1]->surf);
+  } else {
     const fcm_embedded_surface *a = sim[0]->surf, *b = sim[1]->surf;
     TEST_TRUE(a && b);
     if (!a || !b) goto done;

@@ -181,6 +181,8 @@ foreach(el hex8 hex20)
   fcm_add_test(sim_cut_overlap_multigrid_${el} tests/sim/cut_overlap.c ARGS ${el} multigrid)
 endforeach()
 fcm_add_test(sim_cut_overlap_fail_hex8 tests/sim/cut_overlap.c ARGS hex8 fail)
+# Without an output surface the values and the structure go side by side all the same.
+fcm_add_test(sim_cut_overlap_nosurface_hex8 tests/sim/cut_overlap.c ARGS hex8 nosurface)
 # The integrator of a cut onto a patched space takes the mass rows and load entries the cut
 # leaves from the old integrator (moved within its storage, or copied) and equals one built from
 # scratch bit for bit, over three cuts; a failed cut leaves the old one going on.

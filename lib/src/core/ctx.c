@@ -229,24 +229,30 @@ fcm_status fcm__error(fcm_ctx *ctx, fcm_status code, const char *file, int line,
   return code;
 }
 
+/* "prefix: " then as much of msg (cap bytes) as fits. */
+static void prefix_message(char *msg, size_t cap, const char *prefix)
+{
+  char old[FCM__MSG_LEN];
+  snprintf(old, sizeof old, "%s", msg);
+  const size_t np = strlen(prefix);
+  if (np + 3 >= cap) return;
+  const size_t room = cap - np - 3, no = strlen(old), k = no < room ? no : room;
+  memcpy(msg, prefix, np);
+  memcpy(msg + np, ": ", 2);
+  memcpy(msg + np + 2, old, k);
+  msg[np + 2 + k] = '\0';
+}
+
 void fcm__error_prefix(fcm_ctx *ctx, const char *prefix)
 {
   if (!ctx || !prefix) return;
-#pragma omp critical(fcm_error)
-  if (ctx->err_status != FCM_OK) {
-    char old[sizeof ctx->err_msg];
-    memcpy(old, ctx->err_msg, sizeof old);
-    old[sizeof old - 1] = '\0';
-    const size_t np = strlen(prefix), cap = sizeof ctx->err_msg;
-    if (np + 3 < cap) { /* "prefix: " then as much of the old message as fits */
-      memcpy(ctx->err_msg, prefix, np);
-      memcpy(ctx->err_msg + np, ": ", 2);
-      const size_t room = cap - np - 3, no = strlen(old);
-      const size_t k = no < room ? no : room;
-      memcpy(ctx->err_msg + np + 2, old, k);
-      ctx->err_msg[np + 2 + k] = '\0';
-    }
+  fcm__loop_iter *it = active_iter(ctx);
+  if (it) { /* the iteration's own error, thread-private: the loop reports it */
+    if (it->rec.code != FCM_OK) prefix_message(it->rec.msg, sizeof it->rec.msg, prefix);
+    return;
   }
+#pragma omp critical(fcm_error)
+  if (ctx->err_status != FCM_OK) prefix_message(ctx->err_msg, sizeof ctx->err_msg, prefix);
 }
 
 void fcm__trace(fcm_ctx *ctx, const char *file, int line, const char *func)

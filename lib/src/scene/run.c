@@ -484,11 +484,14 @@ static fcm_status cut_parts(fcm_simulation *S, const fcm_space *space, fcm_integ
   fcm_ctx *ctx = S->ctx;
   fcm__loop L;
   fcm__integrator_cut cut;
-  const int two = S->surf && !S->distributed && !fcm__integrator_distributed(S->integ, NULL) &&
-                  fcm_ctx_num_threads(ctx) > 1 && !S->cuts_in_turn;
+  const int two_threads = !S->distributed && !fcm__integrator_distributed(S->integ, NULL) &&
+                          fcm_ctx_num_threads(ctx) > 1 && !S->cuts_in_turn;
   int team = 1, next = 0;
   st = fcm__integrator_cut_begin(S->integ, space, &cut);
   if (st == FCM_OK) {
+    /* side by side when a second long part goes beside the values: the structure or the
+     * surface (the log's blocks alone would leave the values' loops one thread for little) */
+    const int two = two_threads && (S->surf || fcm__integrator_cut_has_structure(&cut));
     fcm__loop_begin(ctx, &L);
 #pragma omp parallel num_threads(2) if (two)
     {

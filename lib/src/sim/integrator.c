@@ -805,6 +805,11 @@ fcm_status fcm__integrator_cut_structure(fcm__integrator_cut *cut)
   return st;
 }
 
+int fcm__integrator_cut_has_structure(const fcm__integrator_cut *cut)
+{
+  return cut->integ && fcm__sim_structure_wanted(cut->integ);
+}
+
 fcm_status fcm__integrator_cut_end(fcm__integrator_cut *cut, fcm_status st, fcm_integrator **integ)
 {
   fcm_integrator *I = cut->integ;

@@ -356,6 +356,11 @@ static int mg_structure_wanted(const fcm_integrator *I)
          !I->space->is_local;
 }
 
+int fcm__sim_structure_wanted(const fcm_integrator *I)
+{
+  return mg_structure_wanted(I);
+}
+
 /* The solver's structure (mg_structure_wanted()): the hierarchy on H's pattern with the
  * constrained DOFs `con` (n entries) and its version `version` (mg_con), for the first set-up
  * (mg_prepare(): fcm_mg_setup() when that active set holds at the step). Reads of I only

@@ -76,6 +76,9 @@ FCM_COMPONENT_API fcm_status fcm__integrator_cut_begin(const fcm_integrator *old
 FCM_COMPONENT_API fcm_status fcm__integrator_cut_values(fcm__integrator_cut *cut);
 /* The structure job, after a successful begin; beside the values job or before or after it. */
 FCM_COMPONENT_API fcm_status fcm__integrator_cut_structure(fcm__integrator_cut *cut);
+/* Whether the structure job has work (the multigrid solver's hierarchy; else it returns at
+ * once), after a successful begin. */
+FCM_COMPONENT_API int fcm__integrator_cut_has_structure(const fcm__integrator_cut *cut);
 /* The end, st the outcome of the stages run (FCM_OK: every one succeeded): on FCM_OK *integ
  * the new integrator and a giver spent; else everything of the new integrator freed, the
  * storage given back to old (fcm__sim_cut_give_back(): old goes on) and *integ NULL. Returns

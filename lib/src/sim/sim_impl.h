@@ -341,6 +341,10 @@ long long fcm__sim_analyses(const fcm_integrator *I);
 /* Multigrid hierarchies the integrator created (prepared ones too). (linsolve.c) */
 long long fcm__sim_mg_creations(const fcm_integrator *I);
 
+/* Whether fcm__sim_prepare_solver_cut() makes a structure (the multigrid solver's hierarchy
+ * on a serial space without hanging nodes). */
+int fcm__sim_structure_wanted(const fcm_integrator *I);
+
 /* fcm_integrator_prepare_solver() of the integrator a cut made from `old` (on the space before
  * the cut): the multigrid hierarchy's structure takes what the cut left from old's hierarchy
  * (fcm__mg_create_pattern_cut(); the same bits), which is only read. Needs only the setup's
