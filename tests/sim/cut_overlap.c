@@ -13,8 +13,9 @@
  * cut the hierarchy is the structure's of the active set the state holds, and the two runs
  * create the same number of hierarchies. With "fail" (multigrid) the second cut fails at an
  * allocation spread over the cut's allocations (the allocator counts atomically: the parts
- * allocate side by side), with the parts in turn and side by side: the run goes on with the
- * integrator it had (its storage given back), steps to the end and leaks nothing. With
+ * allocate side by side), and at every allocation from it on, with the parts in turn and
+ * side by side: the run goes on with the integrator it had (its storage given back, which
+ * allocates nothing), steps to the end and leaks nothing. With
  * "nosurface" (multigrid) the scene writes no output surface: the values and the structure
  * still go side by side.
  * Usage: sim_cut_overlap <element> [threads | multigrid | fail | nosurface] */
@@ -27,16 +28,19 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Allocator counting its calls atomically and failing call number fail_at (-1: none). */
+/* Allocator counting its calls atomically and failing call number fail_at (-1: none), or
+ * with `every` every call from that one on. */
 typedef struct counting {
   long long count, fail_at;
+  int every;
 } counting;
 
 static void *counting_alloc(void *user, size_t size)
 {
   counting *c = user;
   const long long k = __atomic_fetch_add(&c->count, 1, __ATOMIC_RELAXED);
-  return k == __atomic_load_n(&c->fail_at, __ATOMIC_RELAXED) ? NULL : malloc(size);
+  const long long at = __atomic_load_n(&c->fail_at, __ATOMIC_RELAXED);
+  return at >= 0 && (k == at || (c->every && k > at)) ? NULL : malloc(size);
 }
 
 static void counting_release(void *user, void *p)
@@ -88,10 +92,13 @@ static void check_structure(fcm_simulation *S)
 
 /* The second cut failing at its allocation k (parts in turn or side by side): st ALLOC (or OK
  * when the cut made fewer allocations), the run as it was, going on to the end; *allocs: the
- * cut's allocations when k < 0 (none failed). Returns whether the cut failed. */
-static int cut_failing(const char *element, int in_turn, long long k, long long *allocs)
+ * cut's allocations when k < 0 (none failed). With `every` every allocation from k on fails,
+ * the storage's give-back's too: it allocates nothing (the mass matrix assembled again in the
+ * old integrator's workspace), so the run goes on all the same. Returns whether the cut
+ * failed. */
+static int cut_failing(const char *element, int in_turn, long long k, int every, long long *allocs)
 {
-  counting cnt = {0, -1};
+  counting cnt = {0, -1, every};
   fcm_ctx_options o = fcm_ctx_options_default();
   o.allocator.alloc = counting_alloc;
   o.allocator.release = counting_release;
@@ -148,14 +155,17 @@ static int fail_main(const char *element)
 {
   for (int in_turn = 1; in_turn >= 0; in_turn--) {
     long long allocs = 0;
-    cut_failing(element, in_turn, -1, &allocs);
+    cut_failing(element, in_turn, -1, 0, &allocs);
     TEST_TRUE(allocs > 16);
-    int fails = 0, tried = 0;
-    for (long long k = 0; k < allocs; k += allocs / 24 + 1, tried++)
-      fails += cut_failing(element, in_turn, k, NULL);
-    printf("%s: %d of %d cuts failed at an allocation of %lld\n",
-           in_turn ? "in turn" : "side by side", fails, tried, allocs);
+    int fails = 0, tried = 0, every = 0;
+    for (long long k = 0; k < allocs; k += allocs / 24 + 1, tried++) {
+      fails += cut_failing(element, in_turn, k, 0, NULL);
+      every += cut_failing(element, in_turn, k, 1, NULL);
+    }
+    printf("%s: %d of %d cuts failed at an allocation of %lld, %d with every one from it on\n",
+           in_turn ? "in turn" : "side by side", fails, tried, allocs, every);
     TEST_TRUE(in_turn ? fails == tried : fails > tried / 2);
+    TEST_TRUE(every == tried);
   }
   return TEST_RESULT();
 }
