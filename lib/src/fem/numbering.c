@@ -227,62 +227,62 @@ void fcm__space_copy_support(const fcm_space *s, double *support)
   }
 }
 
-/* Koschier et al. 2017, Sec. 6: a copy whose support (the volume of the pieces that use it)
- * is below `ratio` of its node's (the pieces of all the node's elements) barely contributes
- * and makes the system (nearly) singular; it is constrained to move with its piece: its
- * elements use, in its place, the DOFs of the largest-support copy at another node of those
- * elements, so the fragment follows that copy (exact for translations). A fragment the cuts
- * separate completely (every copy its elements use is tiny) has no such copy: all its copies
- * follow one anchor, the largest copy at any of the fragment's nodes, so the fragment moves
- * with (translates as) that copy's body — Koschier's "sticking", of material below `ratio`
- * of its nodes' supports — and never joins two bodies. Unused copies are then removed from
- * the numbering. Counts in s->num_constrained. */
-fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_index *inc_ptr,
-                                       const fcm_index *inc)
+/* The copies' work arrays of fcm__space_constrain_copies(). */
+typedef struct copy_work {
+  double *venr;        /* a copy's support volume */
+  fcm_index *master;   /* the copy it follows (-1: none) */
+  fcm_index *uf;       /* union-find of the tiny copies' fragments */
+  fcm_index *node_of;  /* a copy's node */
+  fcm_index *anchor;   /* a fragment's anchor copy (-1: none, -2: not separated) */
+  unsigned char *tiny; /* the copy's support is below ratio of its node's */
+} copy_work;
+
+/* Which copies are tiny, each against its own node's support; a copy's support (as
+ * fcm__space_copy_support(): its elements' volumes in ascending order) from its node's
+ * elements, every copy being one node's before the constraint. Returns their count. */
+static fcm_index tiny_copies(const fcm_space *s, double ratio, const fcm_index *inc_ptr,
+                             const fcm_index *inc, copy_work *w)
 {
-  fcm_status st = FCM_OK;
-  fcm_ctx *ctx = s->ctx;
   const fcm_index *cells = fcm_mesh_cells(s->mesh);
-  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
-  double *venr = NULL;
-  fcm_index *master = NULL, *renum = NULL, *uf = NULL, *node_of = NULL, *anchor = NULL;
-  unsigned char *tiny = NULL;
-  FCM_ALLOC(ctx, ncopy + 1, venr);
-  FCM_ALLOC(ctx, ncopy + 1, master);
-  FCM_ALLOC(ctx, ncopy + 1, tiny);
-  FCM_ALLOC(ctx, ncopy + 1, uf);
-  FCM_ALLOC(ctx, ncopy + 1, node_of);
-  FCM_ALLOC(ctx, ncopy + 1, anchor);
-  /* which copies are tiny, each against its own node's support; a copy's support (as
-   * fcm__space_copy_support(): its elements' volumes in ascending order) from its node's
-   * elements, every copy being one node's before the constraint */
+  const fcm_index nn = s->nn;
   fcm_index ntiny = 0;
-#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(static) reduction(+ : ntiny)
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(s->ctx)) schedule(static) \
+    reduction(+ : ntiny)
   for (fcm_index n = 0; n < s->num_nodes; n++) {
     double vsupp = 0.0;
     for (fcm_index c = 0; c < s->node_ncopy[n]; c++)
-      venr[s->node_dof[n] / 3 + c] = 0.0;
+      w->venr[s->node_dof[n] / 3 + c] = 0.0;
     for (fcm_index i = inc_ptr[n]; i < inc_ptr[n + 1]; i++) {
       const fcm_index e = inc[i];
       const double v = fcm_cell_rules_piece_volume(s->rules, s->elem_piece[e]);
       int a = 0;
       while (a < nn - 1 && cells[s->elem_cell[e] * nn + a] != n)
         a++;
-      venr[s->elem_dof[e * nn + a] / 3] += v;
+      w->venr[s->elem_dof[e * nn + a] / 3] += v;
       vsupp += v;
     }
     for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
       const fcm_index k = s->node_dof[n] / 3 + c;
-      node_of[k] = n;
-      tiny[k] = s->node_ncopy[n] > 1 && venr[k] < ratio * vsupp;
-      ntiny += tiny[k];
+      w->node_of[k] = n;
+      w->tiny[k] = s->node_ncopy[n] > 1 && w->venr[k] < ratio * vsupp;
+      ntiny += w->tiny[k];
     }
   }
-  for (fcm_index k = 0; k < ncopy; k++)
-    master[k] = anchor[k] = -1, uf[k] = k;
-  if (ntiny == 0) goto cleanup;
-  /* rule 1: the largest non-tiny copy at another node of an element that uses the copy;
-   * elements using only tiny copies join them into separated fragments (union-find) */
+  return ntiny;
+}
+
+/* Each tiny copy's master (w->master; -1: none). Rule 1: the largest non-tiny copy at another
+ * node of an element that uses the copy; elements using only tiny copies join them into
+ * separated fragments (union-find). Rule 2: a fragment none of whose copies found a master
+ * follows its anchor, the largest non-tiny copy at the node of one of its copies. Returns the
+ * number of copies with a master. */
+static fcm_index copy_masters(const fcm_space *s, copy_work *w)
+{
+  const fcm_index *cells = fcm_mesh_cells(s->mesh);
+  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  unsigned char *tiny = w->tiny;
+  fcm_index *master = w->master, *uf = w->uf, *anchor = w->anchor;
+  const double *venr = w->venr;
   for (fcm_index e = 0; e < s->num_elems; e++) {
     const fcm_index *d = s->elem_dof + e * nn;
     int all_tiny = 1;
@@ -298,19 +298,18 @@ fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_ind
       }
       for (int b = 0; b < nn; b++) {
         const fcm_index m = d[b] / 3;
-        if (cells[s->elem_cell[e] * nn + b] == node_of[k] || tiny[m]) continue;
+        if (cells[s->elem_cell[e] * nn + b] == w->node_of[k] || tiny[m]) continue;
         if (master[k] < 0 || venr[m] > venr[master[k]] ||
             (venr[m] == venr[master[k]] && m < master[k]))
           master[k] = m;
       }
     }
   }
-  /* rule 2: a fragment none of whose copies found a master follows its anchor */
   for (fcm_index k = 0; k < ncopy; k++) /* fragments with a rule-1 master are not separated */
     if (tiny[k] && master[k] >= 0) anchor[uf_find(uf, k)] = -2;
   for (fcm_index k = 0; k < ncopy; k++) {
     if (!tiny[k]) continue;
-    const fcm_index r = uf_find(uf, k), n = node_of[k];
+    const fcm_index r = uf_find(uf, k), n = w->node_of[k];
     if (anchor[r] == -2) continue;
     for (fcm_index c = 0; c < s->node_ncopy[n]; c++) {
       const fcm_index m = s->node_dof[n] / 3 + c;
@@ -324,43 +323,84 @@ fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_ind
     if (master[k] < 0 && anchor[r] >= 0) master[k] = anchor[r];
     count += master[k] >= 0;
   }
-  if (count > 0) {
-    FCM_ALLOC(ctx, (size_t)s->num_elems * nn + 1, s->elem_con);
-    for (fcm_index e = 0; e < s->num_elems; e++)
-      for (int a = 0; a < nn; a++) {
-        const fcm_index k = s->elem_dof[e * nn + a] / 3;
-        if (master[k] < 0) continue;
-        s->elem_dof[e * nn + a] = 3 * master[k];
-        s->elem_con[e * nn + a] = 1;
-      }
-    /* renumber the copies still in use, node by node */
-    FCM_ALLOC(ctx, ncopy + 1, renum);
-    fcm_index next = 0;
-    for (fcm_index n = 0; n < s->num_nodes; n++) {
-      if (s->node_dof[n] < 0) continue;
-      const fcm_index k0 = s->node_dof[n] / 3, nc = s->node_ncopy[n];
-      fcm_index kept = 0;
-      for (fcm_index c = 0; c < nc; c++) {
-        renum[k0 + c] = master[k0 + c] >= 0 ? -1 : next + kept;
-        kept += master[k0 + c] < 0;
-      }
-      s->node_dof[n] = kept ? 3 * next : -1;
-      s->node_ncopy[n] = kept;
-      next += kept;
+  return count;
+}
+
+/* The elements' DOFs of the copies with a master (master) moved to it and flagged
+ * (s->elem_con), the copies still in use renumbered node by node. */
+static fcm_status follow_masters(fcm_space *s, const fcm_index *master)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3, nn = s->nn;
+  fcm_index *renum = NULL;
+  FCM_ALLOC(ctx, (size_t)s->num_elems * nn + 1, s->elem_con);
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    for (int a = 0; a < nn; a++) {
+      const fcm_index k = s->elem_dof[e * nn + a] / 3;
+      if (master[k] < 0) continue;
+      s->elem_dof[e * nn + a] = 3 * master[k];
+      s->elem_con[e * nn + a] = 1;
     }
-    for (fcm_index e = 0; e < s->num_elems; e++)
-      for (int a = 0; a < nn; a++)
-        s->elem_dof[e * nn + a] = 3 * renum[s->elem_dof[e * nn + a] / 3];
-    s->num_dofs = 3 * next;
+  FCM_ALLOC(ctx, ncopy + 1, renum);
+  fcm_index next = 0;
+  for (fcm_index n = 0; n < s->num_nodes; n++) {
+    if (s->node_dof[n] < 0) continue;
+    const fcm_index k0 = s->node_dof[n] / 3, nc = s->node_ncopy[n];
+    fcm_index kept = 0;
+    for (fcm_index c = 0; c < nc; c++) {
+      renum[k0 + c] = master[k0 + c] >= 0 ? -1 : next + kept;
+      kept += master[k0 + c] < 0;
+    }
+    s->node_dof[n] = kept ? 3 * next : -1;
+    s->node_ncopy[n] = kept;
+    next += kept;
   }
+  for (fcm_index e = 0; e < s->num_elems; e++)
+    for (int a = 0; a < nn; a++)
+      s->elem_dof[e * nn + a] = 3 * renum[s->elem_dof[e * nn + a] / 3];
+  s->num_dofs = 3 * next;
+cleanup:
+  fcm__free(ctx, renum);
+  return st;
+}
+
+/* Koschier et al. 2017, Sec. 6: a copy whose support (the volume of the pieces that use it)
+ * is below `ratio` of its node's (the pieces of all the node's elements) barely contributes
+ * and makes the system (nearly) singular; it is constrained to move with its piece: its
+ * elements use, in its place, the DOFs of the largest-support copy at another node of those
+ * elements, so the fragment follows that copy (exact for translations). A fragment the cuts
+ * separate completely (every copy its elements use is tiny) has no such copy: all its copies
+ * follow one anchor, the largest copy at any of the fragment's nodes, so the fragment moves
+ * with (translates as) that copy's body — Koschier's "sticking", of material below `ratio`
+ * of its nodes' supports — and never joins two bodies. Unused copies are then removed from
+ * the numbering. Counts in s->num_constrained. */
+fcm_status fcm__space_constrain_copies(fcm_space *s, double ratio, const fcm_index *inc_ptr,
+                                       const fcm_index *inc)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = s->ctx;
+  const fcm_index ncopy = s->num_dofs / 3;
+  copy_work w;
+  memset(&w, 0, sizeof w);
+  FCM_ALLOC(ctx, ncopy + 1, w.venr);
+  FCM_ALLOC(ctx, ncopy + 1, w.master);
+  FCM_ALLOC(ctx, ncopy + 1, w.tiny);
+  FCM_ALLOC(ctx, ncopy + 1, w.uf);
+  FCM_ALLOC(ctx, ncopy + 1, w.node_of);
+  FCM_ALLOC(ctx, ncopy + 1, w.anchor);
+  const fcm_index ntiny = tiny_copies(s, ratio, inc_ptr, inc, &w);
+  for (fcm_index k = 0; k < ncopy; k++)
+    w.master[k] = w.anchor[k] = -1, w.uf[k] = k;
+  const fcm_index count = ntiny > 0 ? copy_masters(s, &w) : 0;
+  if (count > 0) FCM_TRY(ctx, follow_masters(s, w.master));
   s->num_constrained = count;
 cleanup:
-  fcm__free(ctx, venr);
-  fcm__free(ctx, master);
-  fcm__free(ctx, renum);
-  fcm__free(ctx, tiny);
-  fcm__free(ctx, uf);
-  fcm__free(ctx, node_of);
-  fcm__free(ctx, anchor);
+  fcm__free(ctx, w.venr);
+  fcm__free(ctx, w.master);
+  fcm__free(ctx, w.tiny);
+  fcm__free(ctx, w.uf);
+  fcm__free(ctx, w.node_of);
+  fcm__free(ctx, w.anchor);
   return st;
 }
