@@ -403,11 +403,14 @@ cleanup:
 
 /* Level l's block smoother on its matrix's values: after a set-up of this hierarchy (or its
  * creation with values) the positions of the blocks' entries were checked against the pattern,
- * which a set-up keeps (the Galerkin plans rely on it too), so they are not checked again. */
-static fcm_status setup_blocks(fcm_mg *m, int l, int first)
+ * which a set-up keeps (the Galerkin plans rely on it too), so they are not checked again; nor
+ * after a creation on the pattern (values_pending), which found them from this level's
+ * pattern (scanned, or carried where a block and its rows are the old ones mapped: the same
+ * positions). check: after a failed set-up. */
+static fcm_status setup_blocks(fcm_mg *m, int l, int check)
 {
   const fcm_csr *A = fcm__mg_level_matrix(&m->lev[l]);
-  return first ? fcm_schwarz_setup(m->lev[l].blk, A) : fcm__schwarz_setup_known(m->lev[l].blk, A);
+  return check ? fcm_schwarz_setup(m->lev[l].blk, A) : fcm__schwarz_setup_known(m->lev[l].blk, A);
 }
 
 fcm_status fcm_mg_setup(fcm_mg *m)
@@ -415,15 +418,15 @@ fcm_status fcm_mg_setup(fcm_mg *m)
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m ? m->ctx : NULL;
   FCM_CHECK(m, ctx, FCM_ERR_ARG, "mg_setup: NULL argument");
-  /* the first set-up (after a creation on a pattern or a failed set-up) computes every level
-   * and checks the blocks' positions; the coarser levels then at every coarse_interval-th; a
-   * single level is the finest, factored at every set-up */
-  const int first = m->values_pending || m->setup_failed;
+  /* the first set-up (after a creation on a pattern or a failed set-up) computes every level,
+   * after a failed one checking the blocks' positions (setup_blocks()); the coarser levels
+   * then at every coarse_interval-th; a single level is the finest, factored at every set-up */
+  const int first = m->values_pending || m->setup_failed, check = m->setup_failed;
   const int coarse = first || m->nlev == 1 || m->setups % m->opts.coarse_interval == 0;
   m->setup_failed = 1; /* until this one succeeds: the levels' values may be mixed */
   FCM_TRY(ctx, level0_values(m));
   for (int l = 0; l + 1 < m->nlev && (l == 0 || coarse); l++) {
-    if (m->lev[l].blk) FCM_TRY(ctx, setup_blocks(m, l, first));
+    if (m->lev[l].blk) FCM_TRY(ctx, setup_blocks(m, l, check));
     if (coarse) FCM_TRY(ctx, galerkin_values(m, l));
   }
   if (coarse)
