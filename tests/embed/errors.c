@@ -5,12 +5,14 @@
  * allocation-failure loop (fail the k-th allocation, k = 0, 1, ... until success; one
  * thread): FCM_ERR_ALLOC, NULL output, nothing leaked. */
 #include "fcm/embed.h"
+#include "embed/embed_impl.h"
 #include "geom/geom_impl.h"
 #include "fcm/surface.h"
 #include "test.h"
 #include "test_alloc.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 static void arguments(fcm_ctx *ctx)
 {
@@ -142,6 +144,95 @@ static void allocation_failures(void)
   fcm_ctx_destroy(&ctx);
 }
 
+/* The allocation-failure loop of a cut (fcm_cell_rules_create_cut()) of a body given by its
+ * surface alone, with the stiffness on the mass space (the pieces' fits, their candidates, the
+ * links between cells, the gathering of the copied cells' rules): FCM_ERR_ALLOC, NULL output,
+ * nothing leaked; the cut that succeeds equals the cut made without failures, bit for bit. The
+ * allocator fills every block with garbage: what the library reads unwritten shows. */
+static void *poisoned_alloc(void *user, size_t size)
+{
+  void *p = failing_alloc(user, size);
+  if (p) memset(p, 0xA5, size);
+  return p;
+}
+
+static void cut_allocation_failures(void)
+{
+  failing f = {0, -1};
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.allocator.alloc = poisoned_alloc; /* what is read before it is written is garbage */
+  co.allocator.release = failing_release;
+  co.allocator.user = &f;
+  fcm_ctx *ctx = NULL;
+  TEST_OK(NULL, fcm_ctx_create(&co, &ctx));
+  if (!ctx) return;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1)); /* the failing allocator's counter is not atomic */
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c0[3] = {0.07, -0.03, 0.02};
+  const fcm_index n[3] = {4, 4, 3};
+  const double p[3] = {0.11, 0.0, 0.0}, nrm[3] = {1.0, 0.2, 0.1}, plo[3] = {-2, -2, -2},
+               phi[3] = {2, 2, 2};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *tets = NULL, *g = NULL;
+  fcm_surface *s = NULL, *blade = NULL;
+  fcm_cell_rules *r0 = NULL, *ref = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.8, 1, &tets));
+  if (tets)
+    TEST_OK(ctx, fcm_surface_create(ctx, fcm_geometry_num_nodes(tets), fcm_geometry_coords(tets),
+                                    fcm_geometry_num_boundary_triangles(tets),
+                                    fcm_geometry_boundary_triangles(tets), &s));
+  fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
+  mo.volume_mesh = 0;
+  if (s) TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, s, &mo, &g));
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p, nrm, plo, phi, &blade));
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.moments = FCM_CELL_MOMENTS_SURFACE;
+  o.stiffness_on_mass_space = 1;
+  if (mesh && g) TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r0));
+  if (r0 && blade) TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &ref));
+  const long long live = fcm_ctx_live_allocations(ctx);
+  int ok = 0, fails = 0;
+  for (long k = 0; k < 1000000 && !ok && ref; k++) {
+    fcm_cell_rules *r = (fcm_cell_rules *)&f;
+    f.count = 0, f.fail_at = k;
+    const fcm_status st = fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &r);
+    f.fail_at = -1;
+    if (st == FCM_OK) {
+      ok = 1;
+      const fcm_index np = fcm_cell_rules_num_pieces(r);
+      int same = np == fcm_cell_rules_num_pieces(ref) && r->num_links == ref->num_links &&
+                 !memcmp(r->links, ref->links, 2 * (size_t)r->num_links * sizeof *r->links);
+      for (int kind = 0; kind < FCM_RULE_KIND_COUNT && same; kind++) {
+        const size_t m = (size_t)ref->off[kind][np];
+        same = !memcmp(r->off[kind], ref->off[kind], ((size_t)np + 1) * sizeof(fcm_index)) &&
+               !memcmp(r->points[kind], ref->points[kind], 3 * m * sizeof(double)) &&
+               !memcmp(r->weights[kind], ref->weights[kind], m * sizeof(double)) &&
+               !memcmp(r->flags[kind], ref->flags[kind], m);
+      }
+      TEST_TRUE(same && ref->num_links > 0 && ref->off[FCM_RULE_MASS][np] > 0);
+      fcm_cell_rules_destroy(&r);
+    } else {
+      fails++;
+      if (!(st == FCM_ERR_ALLOC && r == NULL))
+        TEST_FAIL_("cut, allocation %ld failing: status %s, rules %p", k, fcm_status_name(st),
+                   (void *)r);
+    }
+    if (fcm_ctx_live_allocations(ctx) != live)
+      TEST_FAIL_("cut, allocation %ld failing: %lld allocations leaked", k,
+                 fcm_ctx_live_allocations(ctx) - live);
+    fcm_ctx_error_clear(ctx);
+  }
+  TEST_TRUE(ok && fails > 100);
+  fcm_cell_rules_destroy(&ref);
+  fcm_cell_rules_destroy(&r0);
+  fcm_surface_destroy(&blade);
+  fcm_surface_destroy(&s);
+  fcm_geometry_destroy(&g);
+  fcm_geometry_destroy(&tets);
+  fcm_mesh_destroy(&mesh);
+  fcm_ctx_destroy(&ctx);
+}
+
 /* A cut surface whose triangles all lack area (collinear, repeated or sliver vertices) would
  * separate nothing: refused with FCM_ERR_GEOMETRY giving the count and the first; one
  * triangle of positive area among them makes a cut (the others are skipped). */
@@ -188,5 +279,6 @@ int main(void)
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
   allocation_failures();
+  cut_allocation_failures();
   return TEST_RESULT();
 }

@@ -1,7 +1,10 @@
 /* AABB tree: queries return exactly the boxes a brute-force scan finds, ascending, for
  * random boxes of mixed sizes (including degenerate flat and point boxes); an empty tree
- * answers nothing; count > capacity reports the count; bad arguments fail cleanly. */
+ * answers nothing; count > capacity reports the count; bad arguments fail cleanly. The bounds
+ * (fcm__geom_tree_bounds()) are the boxes' least and greatest coordinates; an empty tree has
+ * none. */
 #include "fcm/geom.h"
+#include "geom/geom_impl.h"
 #include "exact.h"
 #include "test.h"
 
@@ -31,6 +34,18 @@ int main(void)
   fcm_aabb_tree *tree = NULL;
   TEST_OK(ctx, fcm_aabb_tree_create(ctx, NBOX, boxes, &tree));
   fcm_index *ids = malloc(NBOX * sizeof *ids);
+  if (tree) {
+    double blo[3], bhi[3];
+    int same = fcm__geom_tree_bounds(tree, blo, bhi);
+    for (int d = 0; d < 3; d++) {
+      double a = boxes[d], b = boxes[3 + d];
+      for (int i = 1; i < NBOX; i++)
+        a = boxes[6 * i + d] < a ? boxes[6 * i + d] : a,
+        b = boxes[6 * i + 3 + d] > b ? boxes[6 * i + 3 + d] : b;
+      same = same && blo[d] == a && bhi[d] == b;
+    }
+    TEST_TRUE(same);
+  }
   for (int q = 0; q < 300; q++) {
     double lo[3], hi[3];
     for (int d = 0; d < 3; d++) {
@@ -80,6 +95,8 @@ int main(void)
   TEST_OK(ctx, fcm_aabb_tree_create(ctx, 0, NULL, &tree));
   TEST_OK(ctx, fcm_aabb_tree_query(tree, lo, hi, 0, NULL, &count));
   TEST_TRUE(count == 0);
+  double elo[3], ehi[3];
+  if (tree) TEST_TRUE(fcm__geom_tree_bounds(tree, elo, ehi) == 0);
   fcm_aabb_tree_destroy(&tree);
   fcm_aabb_tree_destroy(NULL);
   free(ids);

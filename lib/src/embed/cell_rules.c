@@ -66,7 +66,7 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   B.red = red;
   B.remote = x ? x->remote : NULL;
   if (R->num_cut_tris > 0) FCM_TRY(ctx, fcm__embed_cut_setup(&B, R, first_new));
-  FCM_ALLOC(ctx, (size_t)nc, out);
+  FCM_ALLOC_RAW(ctx, (size_t)nc, out); /* zeroed cell by cell by fcm__embed_run_cells() */
   const double t_setup = fcm_wtime();
   /* 2. parallel per-cell work */
   const int nthreads = fcm_ctx_num_threads(ctx);

@@ -550,6 +550,7 @@ static void run_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_
 {
   fcm_ctx *ctx = B->ctx;
   const fcm_index nc = R->num_cells;
+  memset(out + c, 0, sizeof *out); /* first touched here, by the thread that builds it */
   if (fcm__loop_skip(loop, c)) return;
   fcm__loop_iter it;
   fcm__loop_enter(loop, &it, c);
@@ -574,8 +575,9 @@ static void run_cell(const build *B, fcm_cell_rules *R, fcm_index c, fcm__embed_
   }
 }
 
-/* Phase 2: every cell in parallel into its own cell_out; thread sums into *sums. An error
- * is that of the lowest failing cell, whatever the thread count. */
+/* Phase 2: every cell in parallel into its own cell_out (out not zeroed before: each entry is
+ * zeroed here, whatever the outcome); thread sums into *sums. An error is that of the lowest
+ * failing cell, whatever the thread count. */
 fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads, cell_out *out,
                                 cell_sums *sums, const fcm_cell_rules_options *opt)
 {
@@ -583,6 +585,7 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
   fcm_ctx *ctx = B->ctx;
   const fcm_index nc = R->num_cells;
   fcm_index done = 0, first = nc;
+  int ran = 0; /* the loops ran: every entry of out zeroed */
   double last = fcm_wtime();
   fcm__loop loop;
   fcm_index *order = NULL; /* a cut: the cells it integrates again first (the threads' shares
@@ -634,10 +637,12 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
       sums->time_simplify += mine.time_simplify;
     }
   }
+  ran = 1;
   if (blas_threads > 1) fcm_blas_set_num_threads(blas_threads);
   FCM_TRY(ctx, fcm__loop_end(&loop, NULL));
   if (opt->progress) opt->progress(nc, nc, opt->progress_user);
 cleanup:
+  if (!ran) memset(out, 0, (size_t)nc * sizeof *out);
   fcm__free(ctx, order);
   return st;
 }

@@ -198,6 +198,7 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
   P->nfx = P->nfp = 0;
   for (size_t i = 0; i < P->n; i++) {
     const fcm__poly *p = P->poly + i;
+    int full = -1; /* fcm__embed_part_full(), asked at the part's first face polygon */
     for (int f = 0; f < p->nf; f++) {
       fcm__plane pl;
       if (!fcm__embed_face_plane(p, f, &pl)) continue;
@@ -233,7 +234,9 @@ fcm_status fcm__embed_face_polygons(fcm_ctx *ctx, const fcm__embed_cell *cell, f
         meta[1] = P->piece[i];
         meta[2] = (int)m;
         meta[3] = p->nv;
-        meta[4] = P->mat && P->piece[i] >= 0 && fcm__embed_part_face_full(P, i, cp->n, cell->size);
+        if (P->mat && P->piece[i] >= 0 && full < 0) full = fcm__embed_part_full(P, i);
+        meta[4] =
+            P->mat && P->piece[i] >= 0 && fcm__embed_part_face_deep(P, i, full, cp->n, cell->size);
         P->nfp++;
         P->nfx += mv;
         break;

@@ -166,6 +166,34 @@ cleanup:
 /* reached_cells(): the bits of a cell the cuts reach */
 enum { REACH = 1, REACH_EARLIER = 2, REACH_NEW = 4 };
 
+/* Whether cell c's corners lie beyond the box lo..hi (all the cut triangles' boxes) along
+ * some axis by more than the widening of its box in fcm__embed_cut_candidates() (the cell's
+ * clip tolerance and twice the match tolerance of its size, the diagonal of its corners' box,
+ * at most the sum of its sides), with a factor two and a margin above the rounding: then no
+ * cut triangle's box meets the widened cell box, and the cell needs neither its box's size
+ * nor a query of the tree. */
+static int far_from_cuts(const fcm_mesh *mesh, int corners, double clip_rtol, fcm_index c,
+                         const double lo[3], const double hi[3])
+{
+  const fcm_index *nodes = fcm_mesh_cells(mesh) + (size_t)fcm_mesh_nodes_per_cell(mesh) * c;
+  const double *X = fcm_mesh_coords(mesh);
+  double a[3], b[3];
+  for (int d = 0; d < 3; d++)
+    a[d] = b[d] = X[3 * nodes[0] + d];
+  for (int k = 1; k < corners; k++)
+    for (int d = 0; d < 3; d++) {
+      const double x = X[3 * nodes[k] + d];
+      a[d] = x < a[d] ? x : a[d], b[d] = x > b[d] ? x : b[d];
+    }
+  const double ext = (b[0] - a[0]) + (b[1] - a[1]) + (b[2] - a[2]);
+  const double grow = 2.0 * (clip_rtol + 2.0 * FCM__EMBED_MATCH_RTOL) * ext;
+  for (int d = 0; d < 3; d++) {
+    const double m = grow + 1e-12 * (fabs(a[d]) + fabs(b[d]));
+    if (a[d] - m > hi[d] || b[d] + m < lo[d]) return 1;
+  }
+  return 0;
+}
+
 /* Per cell, in parallel, into hit: 0 where no cut triangle's box meets the cell's (widened by
  * twice the match tolerance), else REACH, with REACH_EARLIER when a triangle before first_new
  * does, REACH_NEW when one from first_new on does. */
@@ -174,6 +202,9 @@ static fcm_status reached_cells(const build *B, fcm_index first_new, unsigned ch
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = B->ctx;
   const fcm_index nc = fcm_mesh_num_cells(B->mesh);
+  const int corners = fcm_mesh_get_element_info(B->mesh)->num_corners;
+  double lo[3], hi[3];
+  if (!fcm__geom_tree_bounds(B->cut_tree, lo, hi)) return FCM_OK; /* no triangle: none reached */
   fcm__loop loop;
   fcm__loop_begin(ctx, &loop);
 #pragma omp parallel num_threads(fcm_ctx_num_threads(ctx))
@@ -181,6 +212,7 @@ static fcm_status reached_cells(const build *B, fcm_index first_new, unsigned ch
     fcm__idbuf ids = {NULL, 0, 0};
 #pragma omp for schedule(static)
     for (fcm_index c = 0; c < nc; c++) {
+      if (far_from_cuts(B->mesh, corners, B->o->clip_rtol, c, lo, hi)) continue;
       if (fcm__loop_skip(&loop, c)) continue;
       fcm__loop_iter it;
       fcm__loop_enter(&loop, &it, c);
@@ -280,10 +312,12 @@ static fcm_status push_link(fcm_ctx *ctx, fcm_index pa, fcm_index pb, fcm_index 
                             size_t *cap)
 {
   fcm_status st = FCM_OK;
-  if (*nl + 1 > *cap) {
-    const size_t ncap = *cap ? 2 * *cap : 256;
-    void *q = *links;
-    FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * *nl, 2 * ncap, sizeof(fcm_index)));
+  if (*nl + 1 > *cap) { /* a cell's list holds a few links: grown from 8, not zeroed */
+    const size_t ncap = *cap ? 2 * *cap : 8;
+    fcm_index *q = NULL;
+    FCM_ALLOC_RAW(ctx, 2 * ncap, q);
+    if (*nl) memcpy(q, *links, 2 * *nl * sizeof *q);
+    fcm__free(ctx, *links);
     *links = q;
     *cap = ncap;
   }

@@ -810,6 +810,11 @@ int fcm__embed_part_full(const fcm__parts *P, size_t i);
  * cell's. */
 int fcm__embed_part_face_full(const fcm__parts *P, size_t i, const double nrm[3], double size);
 
+/* fcm__embed_part_face_full() with full = fcm__embed_part_full(P, i) known (a part's faces ask
+ * it once). */
+int fcm__embed_part_face_deep(const fcm__parts *P, size_t i, int full, const double nrm[3],
+                              double size);
+
 /* Whether the convex polyhedron p (a part of affine cell) is a box in cell's reference
  * coordinates: 8 vertices, each at a corner of their reference bounding box lo..hi within
  * 1e-13 of the reference cell's size, every corner taken once (a part of a box cell that cuts

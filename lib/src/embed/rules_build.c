@@ -214,29 +214,66 @@ cleanup:
   return st;
 }
 
-/* Cell c's pieces' rules, surface rules and cut faces from o into R's arrays (their offsets
- * set). */
-static void gather_cell(fcm_cell_rules *R, const cell_out *o, fcm_index c)
+/* The copies of one gathering pass: per array, the run of bytes pending (src to dst), extended
+ * while the next piece's source follows it in memory (the pieces a cut copies from the rules it
+ * extends lie one after another there, as in R), else copied and restarted. */
+enum { GATHER_ARRAYS = 3 * FCM_RULE_KIND_COUNT + 5 };
+typedef struct gather_run {
+  unsigned char *dst[GATHER_ARRAYS];
+  const unsigned char *src[GATHER_ARRAYS];
+  size_t len[GATHER_ARRAYS];
+} gather_run;
+
+static void run_flush(gather_run *g, int a)
 {
-  for (int i = 0; i < o->np; i++) {
-    const piece_out *q = o->pc + i;
-    const fcm_index p = R->piece_off[c] + i;
-    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-      const size_t n = (size_t)(R->off[k][p + 1] - R->off[k][p]), o0 = (size_t)R->off[k][p];
-      if (!n) continue;
-      memcpy(R->points[k] + 3 * o0, q->pts[k], 3 * n * sizeof(double));
-      memcpy(R->weights[k] + o0, q->w[k], n * sizeof(double));
-      memcpy(R->flags[k] + o0, q->flag[k], n);
-    }
-    if (q->ncf) memcpy(R->cfxi + 9 * R->cfoff[p], q->cfxi, 9 * (size_t)q->ncf * sizeof(double));
-    const size_t n = (size_t)q->ns, o0 = (size_t)R->soff[p];
-    if (!n) continue;
-    memcpy(R->spoints + 3 * o0, q->spts, 3 * n * sizeof(double));
-    memcpy(R->sweights + o0, q->sw, n * sizeof(double));
-    memcpy(R->snormals + 3 * o0, q->snrm, 3 * n * sizeof(double));
-    memcpy(R->stris + o0, q->stri, n * sizeof(fcm_index));
-  }
+  if (g->len[a]) memcpy(g->dst[a], g->src[a], g->len[a]);
+  g->len[a] = 0;
 }
+
+static void run_add(gather_run *g, int a, void *dst, const void *src, size_t len)
+{
+  if (!len) return;
+  if (g->len[a] && g->src[a] + g->len[a] == (const unsigned char *)src &&
+      g->dst[a] + g->len[a] == (unsigned char *)dst) {
+    g->len[a] += len;
+    return;
+  }
+  run_flush(g, a);
+  g->dst[a] = dst, g->src[a] = src, g->len[a] = len;
+}
+
+/* Cells c0 to c1 - 1's pieces' rules, surface rules and cut faces from out into R's arrays
+ * (their offsets set). */
+static void gather_cells(fcm_cell_rules *R, const cell_out *out, fcm_index c0, fcm_index c1)
+{
+  gather_run g;
+  memset(g.len, 0, sizeof g.len);
+  for (fcm_index c = c0; c < c1; c++) {
+    const cell_out *o = out + c;
+    for (int i = 0; i < o->np; i++) {
+      const piece_out *q = o->pc + i;
+      const fcm_index p = R->piece_off[c] + i;
+      for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+        const size_t n = (size_t)(R->off[k][p + 1] - R->off[k][p]), o0 = (size_t)R->off[k][p];
+        run_add(&g, 3 * k, R->points[k] + 3 * o0, q->pts[k], 3 * n * sizeof(double));
+        run_add(&g, 3 * k + 1, R->weights[k] + o0, q->w[k], n * sizeof(double));
+        run_add(&g, 3 * k + 2, R->flags[k] + o0, q->flag[k], n);
+      }
+      const int a = 3 * FCM_RULE_KIND_COUNT;
+      run_add(&g, a, R->cfxi + 9 * R->cfoff[p], q->cfxi, 9 * (size_t)q->ncf * sizeof(double));
+      const size_t n = (size_t)q->ns, o0 = (size_t)R->soff[p];
+      run_add(&g, a + 1, R->spoints + 3 * o0, q->spts, 3 * n * sizeof(double));
+      run_add(&g, a + 2, R->sweights + o0, q->sw, n * sizeof(double));
+      run_add(&g, a + 3, R->snormals + 3 * o0, q->snrm, 3 * n * sizeof(double));
+      run_add(&g, a + 4, R->stris + o0, q->stri, n * sizeof(fcm_index));
+    }
+  }
+  for (int a = 0; a < GATHER_ARRAYS; a++)
+    run_flush(&g, a);
+}
+
+/* The cells one task of the gathering copies. */
+#define GATHER_CHUNK 256
 
 /* Phase 3: concatenate the pieces' volume and surface rules in cell order. */
 fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_out *out,
@@ -244,57 +281,60 @@ fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_o
 {
   fcm_status st = FCM_OK;
   const fcm_index nc = R->num_cells;
-  fcm_index np = 0;
-  for (fcm_index c = 0; c < nc; c++)
-    np += out[c].np;
-  R->num_pieces = np;
-  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_cell);
-  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_volume);
-  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_parent);
-  FCM_ALLOC(ctx, (size_t)np + 1, R->piece_component);
-  FCM_ALLOC(ctx, (size_t)np + 1, R->soff);
   R->piece_off[0] = 0;
-  for (fcm_index c = 0; c < nc; c++) {
-    R->piece_off[c + 1] = R->piece_off[c] + out[c].np;
-    for (int i = 0; i < out[c].np; i++) {
-      R->piece_cell[R->piece_off[c] + i] = c;
-      R->piece_volume[R->piece_off[c] + i] = out[c].pc[i].volume;
-      R->piece_parent[R->piece_off[c] + i] = prev ? prev->piece_off[c] + out[c].pc[i].parent : -1;
-      R->piece_component[R->piece_off[c] + i] = out[c].pc[i].component;
-    }
-  }
-  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-    fcm_index *off = NULL;
-    FCM_ALLOC(ctx, (size_t)np + 1, R->off[k]);
-    off = R->off[k];
-    for (fcm_index c = 0; c < nc; c++)
-      for (int i = 0; i < out[c].np; i++) {
-        const fcm_index p = R->piece_off[c] + i;
-        off[p + 1] = off[p] + (R->cls[c] == FCM_CELL_CUT ? out[c].pc[i].n[k] : 0);
-      }
-    const size_t tot = (size_t)off[np];
-    FCM_ALLOC(ctx, 3 * tot, R->points[k]);
-    FCM_ALLOC(ctx, tot, R->weights[k]);
-    FCM_ALLOC(ctx, tot, R->flags[k]);
-  }
-  FCM_ALLOC(ctx, (size_t)np + 1, R->cfoff);
-  R->soff[0] = 0;
   for (fcm_index c = 0; c < nc; c++)
-    for (int i = 0; i < out[c].np; i++) {
+    R->piece_off[c + 1] = R->piece_off[c] + out[c].np;
+  const fcm_index np = R->piece_off[nc];
+  R->num_pieces = np;
+  FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->piece_cell);
+  FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->piece_volume);
+  FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->piece_parent);
+  FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->piece_component);
+  FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->soff);
+  FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->cfoff);
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->off[k]);
+  /* every piece's entries of the arrays above in one pass over the cells (the slot past the
+   * last piece of the first four is never read: zeroed as before) */
+  R->piece_cell[np] = 0, R->piece_volume[np] = 0.0, R->piece_parent[np] = 0;
+  R->piece_component[np] = 0;
+  R->soff[0] = R->cfoff[0] = 0;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+    R->off[k][0] = 0;
+  for (fcm_index c = 0; c < nc; c++) {
+    const cell_out *o = out + c;
+    const int cut = R->cls[c] == FCM_CELL_CUT;
+    for (int i = 0; i < o->np; i++) {
+      const piece_out *q = o->pc + i;
       const fcm_index p = R->piece_off[c] + i;
-      R->cfoff[p + 1] = R->cfoff[p] + out[c].pc[i].ncf;
-      R->soff[p + 1] = R->soff[p] + out[c].pc[i].ns;
+      R->piece_cell[p] = c;
+      R->piece_volume[p] = q->volume;
+      R->piece_parent[p] = prev ? prev->piece_off[c] + q->parent : -1;
+      R->piece_component[p] = q->component;
+      for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
+        R->off[k][p + 1] = R->off[k][p] + (cut ? q->n[k] : 0);
+      R->cfoff[p + 1] = R->cfoff[p] + q->ncf;
+      R->soff[p + 1] = R->soff[p] + q->ns;
     }
+  }
+  /* written whole by the copies below */
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    const size_t tot = (size_t)R->off[k][np];
+    FCM_ALLOC_RAW(ctx, 3 * tot, R->points[k]);
+    FCM_ALLOC_RAW(ctx, tot, R->weights[k]);
+    FCM_ALLOC_RAW(ctx, tot, R->flags[k]);
+  }
   FCM_ALLOC(ctx, 9 * (size_t)R->cfoff[np] + 1, R->cfxi);
   const size_t tot = (size_t)R->soff[np];
-  FCM_ALLOC(ctx, 3 * tot, R->spoints);
-  FCM_ALLOC(ctx, tot, R->sweights);
-  FCM_ALLOC(ctx, 3 * tot, R->snormals);
-  FCM_ALLOC(ctx, tot, R->stris);
-  /* the copies, each cell's into its own ranges */
-#pragma omp parallel for schedule(dynamic, 256) num_threads(fcm_ctx_num_threads(ctx))
-  for (fcm_index c = 0; c < nc; c++)
-    gather_cell(R, out + c, c);
+  FCM_ALLOC_RAW(ctx, 3 * tot, R->spoints);
+  FCM_ALLOC_RAW(ctx, tot, R->sweights);
+  FCM_ALLOC_RAW(ctx, 3 * tot, R->snormals);
+  FCM_ALLOC_RAW(ctx, tot, R->stris);
+  /* the copies, each task's cells into their own ranges */
+  const fcm_index nchunks = (nc + GATHER_CHUNK - 1) / GATHER_CHUNK;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(fcm_ctx_num_threads(ctx))
+  for (fcm_index ch = 0; ch < nchunks; ch++)
+    gather_cells(R, out, ch * GATHER_CHUNK, FCM_MIN(nc, (ch + 1) * GATHER_CHUNK));
 cleanup:
   return st;
 }

@@ -145,8 +145,11 @@ static fcm_status piece_candidates(const build *B, const fcm__embed_cell *cell, 
   const size_t all = piece_points(B, ws) - ws->sr->n, keep = FCM_MIN(all, cap);
   double *tets = NULL, *vol = NULL;
   size_t g = 0; /* the tet points' running number, of all */
-  FCM_ALLOC(ctx, 12 * FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV, tets);
-  FCM_ALLOC(ctx, FCM__POLY_MAX_FACES * FCM__POLY_MAX_FV, vol);
+  int most = 0; /* the most fan tets of the piece's parts (each written before it is read) */
+  for (size_t j = 0; j < P->n; j++)
+    if (P->piece[j] == ws->cand_piece) most = FCM_MAX(most, fcm__geom_poly_num_tets(P->poly + j));
+  FCM_ALLOC_RAW(ctx, 12 * (size_t)most + 12, tets);
+  FCM_ALLOC_RAW(ctx, (size_t)most + 1, vol);
   for (size_t j = 0; j < P->n && keep > 0; j++) {
     if (P->piece[j] != ws->cand_piece) continue;
     const int nt = fcm__geom_poly_tets(P->poly + j, tets, vol), full = fcm__embed_part_full(P, j);

@@ -831,7 +831,13 @@ int fcm__embed_part_full(const fcm__parts *P, size_t i)
 
 int fcm__embed_part_face_full(const fcm__parts *P, size_t i, const double nrm[3], double size)
 {
-  if (!fcm__embed_part_full(P, i)) return 0;
+  return fcm__embed_part_face_deep(P, i, fcm__embed_part_full(P, i), nrm, size);
+}
+
+int fcm__embed_part_face_deep(const fcm__parts *P, size_t i, int full, const double nrm[3],
+                              double size)
+{
+  if (!full) return 0;
   const fcm__poly *p = P->poly + i;
   double lo = HUGE_VAL, hi = -HUGE_VAL;
   for (int a = 0; a < p->nv; a++) {

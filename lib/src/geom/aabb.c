@@ -287,6 +287,14 @@ static fcm_status traverse(fcm_ctx *ctx, const fcm_aabb_tree *t, const probe *q,
   return q->segment ? traverse_probe(ctx, t, q, buf, 1) : traverse_probe(ctx, t, q, buf, 0);
 }
 
+int fcm__geom_tree_bounds(const fcm_aabb_tree *t, double lo[3], double hi[3])
+{
+  if (t->num_items == 0) return 0;
+  memcpy(lo, t->nodes[0].lo, 3 * sizeof(double));
+  memcpy(hi, t->nodes[0].hi, 3 * sizeof(double));
+  return 1;
+}
+
 fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *t, const double lo[3],
                                 const double hi[3], fcm__idbuf *buf)
 {

@@ -105,6 +105,9 @@ typedef struct fcm__idbuf {
 fcm_status fcm__geom_tree_query(fcm_ctx *ctx, const fcm_aabb_tree *tree, const double lo[3],
                                 const double hi[3], fcm__idbuf *buf);
 
+/* The box of all the tree's items into lo, hi (the root's); 0 for a tree without items. */
+int fcm__geom_tree_bounds(const fcm_aabb_tree *tree, double lo[3], double hi[3]);
+
 /* Boxes (n x 6: lo[3], hi[3], allocated on ctx) of g's cells (tris = 0) or boundary
  * triangles (tris = 1). */
 fcm_status fcm__geom_boxes(fcm_ctx *ctx, const fcm_geometry *g, int tris, double **out,
