@@ -110,6 +110,12 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__assembly_corot_build(fcm_assembly_workspace *ws, const fcm_material_params *mat)
+{
+  kernel_data kd;
+  return fcm__assembly_corot_prepare(ws, mat, &kd);
+}
+
 fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
                                        const fcm_assembly_workspace *old, const fcm_index *same)
 {

@@ -513,6 +513,12 @@ fcm_status fcm__assembly_linear_blocks(fcm_assembly_workspace *ws, const fcm_lin
 fcm_status fcm__assembly_corot_inherit(fcm_assembly_workspace *ws,
                                        const fcm_assembly_workspace *old, const fcm_index *same);
 
+/* The corotated linear model's kept element stiffnesses of ws's elements not built yet, for
+ * mat (all of them again for other Lamé parameters), so that the first assembly finds them:
+ * what fcm_assembly_workspace_hyperelastic() builds when it meets them first, the same bits.
+ * (corot_store.c) */
+fcm_status fcm__assembly_corot_build(fcm_assembly_workspace *ws, const fcm_material_params *mat);
+
 /* As fcm__assembly_corot_inherit(), on old's storage where its free slots hold ws's new
  * elements (the store has a quarter more slots than its first elements): each kept element
  * keeps its slot (its matrix is neither moved nor copied), the others take the free slots;

@@ -696,6 +696,10 @@ static fcm_status setup_values(fcm_integrator *I)
   if (I->opts.tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE)
     FCM_TRY(ctx, setup_representative_force(I));
   FCM_TRY(ctx, setup_solvers(I));
+  /* the corotated model's element stiffnesses (after a cut, those the cut made new): set-up
+   * work, which the first step would do otherwise */
+  if (I->params.model == FCM_MATERIAL_COROTATED_LINEAR)
+    FCM_TRY(ctx, fcm__assembly_corot_build(I->aws, &I->params));
   setup_initial_state(I);
   FCM_TRY(ctx, fcm__sim_contact_setup(I));
 cleanup:
