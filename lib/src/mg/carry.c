@@ -76,6 +76,37 @@ int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple)
   return ok;
 }
 
+int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag)
+{
+  const fcm_space *sp = m->pattern_of;
+  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
+      m->lev[0].n != 3 * sp->num_local_copies)
+    return 0;
+  const fcm_index nk = sp->num_local_copies, *rp = sp->row_ptr;
+  const int *ci = sp->col_idx;
+  int ok = 1;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
+    if (nk > 4096)
+  for (fcm_index k = 0; k < nk; k++) {
+    fcm_index lo = sp->node_ptr[k], hi = sp->node_ptr[k + 1];
+    while (lo < hi) {
+      const fcm_index mid = lo + (hi - lo) / 2;
+      if (sp->node_adj[mid] < k)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    const fcm_index q = lo - sp->node_ptr[k];
+    for (fcm_index c = 0; c < 3; c++) {
+      const fcm_index i = 3 * k + c, p = rp[i] + 3 * q + c;
+      const int found = p < rp[i + 1] && ci[p] == i;
+      ok = ok && found;
+      diag[i] = found ? p : -1;
+    }
+  }
+  return ok;
+}
+
 void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
 {
   for (int l = 0; l < MG_MAX_LEVELS; l++) {

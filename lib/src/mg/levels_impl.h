@@ -408,6 +408,12 @@ fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
  * (triple unfinished) where that does not apply. */
 int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple);
 
+/* Level 0's diagonal positions (diag, n entries) from the space's copy graph where level 0's
+ * matrix has the space's pattern, as fcm__mg_space_triples() reads it: copy k's row 3 k + c
+ * holds its diagonal at 3 q + c, q the place of k in its graph row; each checked against the
+ * row. 1 when written, 0 (diag unfinished) where that does not apply or a check fails. */
+int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag);
+
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
 int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr);
 
