@@ -47,21 +47,16 @@ static int carry_arow(const carry_work *w, fcm_index i)
   return 1;
 }
 
-/* Copy-graph mode (A_col NULL): are copy k's three rows of A the old copy's rows mapped (its
- * graph rows compared, a copy at a time), reaching only rows of P that are (prow)? */
+/* Copy-graph mode (A_col NULL): are copy k's three rows of A the old copy's rows mapped (the
+ * prior's copy_same: its graph rows compared by the caller), reaching only rows of P that are
+ * (prow)? */
 static int carry_acopy(const carry_work *w, fcm_index k)
 {
   const fcm__ptap_prior *pr = w->pr;
-  const fcm_index *ro = pr->row_old + 3 * k;
-  if (ro[0] < 0 || ro[0] % 3 != 0 || ro[1] != ro[0] + 1 || ro[2] != ro[0] + 2) return 0;
-  const fcm_index g = ro[0] / 3, deg = pr->A_ptr[g + 1] - pr->A_ptr[g];
-  if (pr->G_ptr[k + 1] - pr->G_ptr[k] != deg) return 0;
-  const fcm_index *adj = pr->A_adj + pr->A_ptr[g], *nadj = pr->G_adj + pr->G_ptr[k];
-  for (fcm_index q = 0; q < deg; q++) {
-    const fcm_index j = nadj[q], *rn = pr->row_new + 3 * adj[q];
-    if (rn[0] != 3 * j || rn[1] != 3 * j + 1 || rn[2] != 3 * j + 2 || !w->prow[3 * j] ||
-        !w->prow[3 * j + 1] || !w->prow[3 * j + 2])
-      return 0;
+  if (!pr->copy_same[k]) return 0;
+  for (fcm_index q = pr->G_ptr[k]; q < pr->G_ptr[k + 1]; q++) {
+    const fcm_index j = pr->G_adj[q];
+    if (!w->prow[3 * j] || !w->prow[3 * j + 1] || !w->prow[3 * j + 2]) return 0;
   }
   return 1;
 }
@@ -214,12 +209,13 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
             "ptap_create_from: NULL argument, P_ptr[0] != 0, nc = %lld < 0 or nt = %d < 1",
             (long long)nc, nt);
   {
-    const char *missing = !prior->plan                                        ? "plan"
-                          : !prior->C                                         ? "C"
-                          : !prior->A_ptr                                     ? "A_ptr"
-                          : !prior->A_col && !prior->A_adj                    ? "A_col or A_adj"
-                          : !prior->A_col && (!prior->G_ptr || !prior->G_adj) ? "G_ptr / G_adj"
-                          : !prior->row_old || !prior->row_new                ? "row_old / row_new"
+    const char *missing = !prior->plan                     ? "plan"
+                          : !prior->C                      ? "C"
+                          : !prior->A_ptr                  ? "A_ptr"
+                          : !prior->A_col && !prior->A_adj ? "A_col or A_adj"
+                          : !prior->A_col && (!prior->G_ptr || !prior->G_adj || !prior->copy_same)
+                              ? "G_ptr / G_adj / copy_same"
+                          : !prior->row_old || !prior->row_new   ? "row_old / row_new"
                           : !prior->crow_old || !prior->crow_new ? "crow_old / crow_new"
                                                                  : NULL;
     FCM_CHECK(!missing, ctx, FCM_ERR_ARG, "ptap_create_from: the prior's %s is NULL", missing);

@@ -380,6 +380,8 @@ typedef struct mg_carry {
   const fcm_index *graph[4];               /* fcm__space_cut_copy_map()'s */
   unsigned char *crow_same[MG_MAX_LEVELS]; /* level l >= 1: its rows that are the old ones
                                               mapped in the same order (the plans' c_same) */
+  unsigned char *copy_same; /* level 0, per copy: its three rows the old copy's mapped, column
+                               for column in the same order (the copy graphs compared) */
 } mg_carry;
 
 /* The space when A has the space's pattern (row_ptr and col_idx the space's arrays, shared,
