@@ -83,7 +83,6 @@ int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag)
       m->lev[0].n != 3 * sp->num_local_copies)
     return 0;
   const fcm_index nk = sp->num_local_copies, *rp = sp->row_ptr;
-  const int *ci = sp->col_idx;
   int ok = 1;
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
     if (nk > 4096)
@@ -96,12 +95,16 @@ int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag)
       else
         hi = mid;
     }
-    const fcm_index q = lo - sp->node_ptr[k];
+    /* the row's columns are the graph row's copies' three each (the space's pattern), so
+     * its length and k's place in the graph row tell where column i lies (the columns are
+     * not read: a cache miss a row) */
+    const fcm_index deg = sp->node_ptr[k + 1] - sp->node_ptr[k], q = lo - sp->node_ptr[k];
+    const int own = lo < sp->node_ptr[k + 1] && sp->node_adj[lo] == k;
     for (fcm_index c = 0; c < 3; c++) {
-      const fcm_index i = 3 * k + c, p = rp[i] + 3 * q + c;
-      const int found = p < rp[i + 1] && ci[p] == i;
+      const fcm_index i = 3 * k + c;
+      const int found = own && rp[i + 1] - rp[i] == 3 * deg;
       ok = ok && found;
-      diag[i] = found ? p : -1;
+      diag[i] = found ? rp[i] + 3 * q + c : -1;
     }
   }
   return ok;

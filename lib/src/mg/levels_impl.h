@@ -412,8 +412,9 @@ int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple);
 
 /* Level 0's diagonal positions (diag, n entries) from the space's copy graph where level 0's
  * matrix has the space's pattern, as fcm__mg_space_triples() reads it: copy k's row 3 k + c
- * holds its diagonal at 3 q + c, q the place of k in its graph row; each checked against the
- * row. 1 when written, 0 (diag unfinished) where that does not apply or a check fails. */
+ * holds its diagonal at 3 q + c, q the place of k in its graph row (each row's length
+ * checked, 3 per graph entry). 1 when written, 0 (diag unfinished) where that does not apply
+ * or a check fails. */
 int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag);
 
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
