@@ -65,7 +65,7 @@ static int triples_exact(const fcm_mg *mg, int l)
 
 /* Are level l's diagonal positions those a plain search of each row finds? Level 0's (from the
  * space's copy graph, fcm__mg_space_diag(), which must apply to a matrix of the space's pattern)
- * also found again by it. */
+ * also found again by it, and the rows' reach of fcm__mg_space_reach() their last columns. */
 static int diag_exact(const fcm_mg *mg, int l)
 {
   const mg_level *L = &mg->lev[l];
@@ -87,6 +87,15 @@ static int diag_exact(const fcm_mg *mg, int l)
     TEST_TRUE(d != NULL);
     same = fcm__mg_space_diag(mg, d) && memcmp(d, L->diag, sizeof *d * (size_t)L->n) == 0;
     if (!same) printf("  level 0: the copy graph's diagonal positions differ or do not apply\n");
+    /* the rows' reach (row slabs): the larger of the row and its last column */
+    same = same && fcm__mg_space_reach(mg, d);
+    for (fcm_index i = 0; i < L->n && same; i++) {
+      const fcm_index want = rp[i + 1] > rp[i] ? FCM_MAX(i, (fcm_index)ci[rp[i + 1] - 1]) : i;
+      same = d[i] == want;
+      if (!same)
+        printf("  level 0: row %lld reaches %lld, the copy graph says %lld\n", (long long)i,
+               (long long)want, (long long)d[i]);
+    }
     free(d);
   }
   return same;

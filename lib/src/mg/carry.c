@@ -110,6 +110,29 @@ int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag)
   return ok;
 }
 
+int fcm__mg_space_reach(const fcm_mg *m, fcm_index *reach)
+{
+  const fcm_space *sp = m->pattern_of;
+  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
+      m->lev[0].n != 3 * sp->num_local_copies)
+    return 0;
+  const fcm_index nk = sp->num_local_copies, *rp = sp->row_ptr;
+  int ok = 1;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
+    if (nk > 4096)
+  for (fcm_index k = 0; k < nk; k++) {
+    /* the last column: the graph row's last copy's third (its columns are not read) */
+    const fcm_index deg = sp->node_ptr[k + 1] - sp->node_ptr[k];
+    const fcm_index last = deg > 0 ? 3 * sp->node_adj[sp->node_ptr[k + 1] - 1] + 2 : -1;
+    for (fcm_index c = 0; c < 3; c++) {
+      const fcm_index i = 3 * k + c;
+      ok = ok && rp[i + 1] - rp[i] == 3 * deg;
+      reach[i] = FCM_MAX(i, last);
+    }
+  }
+  return ok;
+}
+
 void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
 {
   for (int l = 0; l < MG_MAX_LEVELS; l++) {

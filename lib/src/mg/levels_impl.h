@@ -417,6 +417,11 @@ int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple);
  * or a check fails. */
 int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag);
 
+/* Level 0's rows' reach (reach, n entries: the larger of the row and its last column) from
+ * the space's copy graph, as fcm__mg_space_diag() reads it. 1 when written, 0 (reach
+ * unfinished) where that does not apply or a row's length is not 3 per graph entry. */
+int fcm__mg_space_reach(const fcm_mg *m, fcm_index *reach);
+
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
 int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr);
 
