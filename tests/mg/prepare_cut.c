@@ -3,7 +3,8 @@
  * a sequence equals the one fcm_mg_create() builds on the new space and matrix, bit for bit
  * (every level's matrix, pattern and values, its inactive rows, and two cycles, memcmp), and
  * its structure equals references computed here the plain way, independently of the
- * creation's shortcuts (a node's repeated rows copied, sorted rows' last columns, the block
+ * creation's shortcuts (a node's repeated rows copied, sorted rows' last columns, level 0's
+ * diagonal positions from the copy graph, the block
  * positions read once for a node's three rows, storage taken from the earlier hierarchy):
  * each coarse level's pattern is the structural pattern of P^T A P with the diagonal (a dense
  * table), the rows' groups of three of one pattern are those a full comparison finds, and the
@@ -62,6 +63,44 @@ static int triples_exact(const fcm_mg *mg, int l)
   return same && groups > 0;
 }
 
+/* Are level l's diagonal positions those a plain search of each row finds? Level 0's (from the
+ * space's copy graph, fcm__mg_space_diag(), which must apply to a matrix of the space's pattern)
+ * also found again by it, and the rows' reach of fcm__mg_space_reach() their last columns. */
+static int diag_exact(const fcm_mg *mg, int l)
+{
+  const mg_level *L = &mg->lev[l];
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A);
+  const int *ci = fcm_csr_col_idx(A);
+  int same = 1;
+  for (fcm_index i = 0; i < L->n && same; i++) {
+    fcm_index p = rp[i];
+    while (p < rp[i + 1] && ci[p] != i)
+      p++;
+    same = p < rp[i + 1] && L->diag[i] == p;
+    if (!same)
+      printf("  level %d: row %lld's diagonal at %lld, is at %lld\n", l, (long long)i,
+             (long long)L->diag[i], (long long)p);
+  }
+  if (l == 0 && same) {
+    fcm_index *d = malloc(sizeof *d * (size_t)(L->n + 1));
+    TEST_TRUE(d != NULL);
+    same = fcm__mg_space_diag(mg, d) && memcmp(d, L->diag, sizeof *d * (size_t)L->n) == 0;
+    if (!same) printf("  level 0: the copy graph's diagonal positions differ or do not apply\n");
+    /* the rows' reach (row slabs): the larger of the row and its last column */
+    same = same && fcm__mg_space_reach(mg, d);
+    for (fcm_index i = 0; i < L->n && same; i++) {
+      const fcm_index want = rp[i + 1] > rp[i] ? FCM_MAX(i, (fcm_index)ci[rp[i + 1] - 1]) : i;
+      same = d[i] == want;
+      if (!same)
+        printf("  level 0: row %lld reaches %lld, the copy graph says %lld\n", (long long)i,
+               (long long)want, (long long)d[i]);
+    }
+    free(d);
+  }
+  return same;
+}
+
 /* The space and clamped matrix of `rules` (mesh and geometry borrowed from base). */
 static void problem_on(fcm_ctx *ctx, const problem *base, const fcm_cell_rules *rules, problem *p)
 {
@@ -99,7 +138,7 @@ static fcm_mg *prepare_and_compare(fcm_ctx *ctx, fcm_mg **old, const problem *p,
   int exact = 1, nblk = 0;
   for (int l = 0; l + 1 < prep->nlev; l++) {
     fcm_index row_slabs = 0, block_slabs = 0;
-    exact &= mgc_galerkin_exact(prep, l) && triples_exact(prep, l);
+    exact &= mgc_galerkin_exact(prep, l) && triples_exact(prep, l) && diag_exact(prep, l);
     TEST_OK(ctx, fcm__mg_slabs_check(prep, l, &row_slabs, &block_slabs));
     nblk += prep->lev[l].blk != NULL;
   }

@@ -190,12 +190,17 @@ typedef struct fcm__ptap_prior {
   const fcm_csr *C;      /* its product (the pattern is read) */
   /* the old A's pattern: CSR rows (A_ptr, A_col), or with A_col NULL a copy graph (A_ptr,
    * A_adj): row i holds 3 j, 3 j + 1, 3 j + 2 for each j of graph row i / 3; then the new A's
-   * pattern must be the copy graph (G_ptr, G_adj) alike (it is compared a copy at a time) and
-   * the maps of A's rows must map a copy's three rows together (3 k + c to 3 k' + c) */
+   * pattern must be the copy graph (G_ptr, G_adj) alike (copy_same compares it a copy at a time)
+   * and the maps of A's rows must map a copy's three rows together (3 k + c to 3 k' + c) */
   const fcm_index *A_ptr;
   const int *A_col;
   const fcm_index *A_adj;
   const fcm_index *G_ptr, *G_adj;
+  /* copy-graph mode: per copy k of the new A, 1 exactly where rows 3 k .. 3 k + 2 map to an
+   * old copy's three in order and G's row k is that copy's old graph row mapped entry by
+   * entry (row_new): the caller compares the graph rows (the block smoothers' carry reads
+   * the same comparison) */
+  const unsigned char *copy_same;
   const fcm_index *row_old, *row_new;   /* A's rows: new -> old, old -> new (-1: none) */
   const fcm_index *crow_old, *crow_new; /* C's rows (P's columns) alike */
 } fcm__ptap_prior;

@@ -277,20 +277,15 @@ static void pattern_gather(const pattern_work *w, fcm_index c, int *Cc)
   }
 }
 
-/* Pattern of C = A B (nrow rows of A, ncol columns of B), each row's columns sorted when
- * `sorted`, else in the order first reached (the same for any thread count); dup (NULL: none)
- * flags the rows whose pattern is the row before's (A's rows and the rows of B they reach
- * giving the same columns in the same order), which are copied instead of computed; bnode
- * (NULL: none) the nodes whose rows of B are shifted per component (row_by_nodes()), whose
- * rows of C are recorded in `closed` (NULL: not recorded; nrow bytes); bclosed (NULL: none)
- * such rows of B (row_by_closed()). Chunks of
- * rows shared by nt threads in one pass: a thread whose buffer is full leaves its chunks for
- * another round after the buffer has grown. */
-static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
-                                  const int *Ac, const fcm_index *Bp, const int *Bc, fcm_index ncol,
-                                  int sorted, const unsigned char *dup, const unsigned char *bnode,
-                                  unsigned char *closed, const unsigned char *bclosed,
-                                  fcm_index **Cp_out, int **Cc_out)
+/* Chunks of rows shared by nt threads in one pass: a thread whose buffer is full leaves its
+ * chunks for another round after the buffer has grown (from `guess` entries in all, or A's
+ * entries and a quarter when 0). */
+fcm_status fcm__ptap_product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
+                                     const int *Ac, const fcm_index *Bp, const int *Bc,
+                                     fcm_index ncol, int sorted, const unsigned char *dup,
+                                     const unsigned char *bnode, unsigned char *closed,
+                                     const unsigned char *bclosed, fcm_index guess,
+                                     fcm_index **Cp_out, int **Cc_out)
 {
   fcm_status st = FCM_OK;
   const fcm_index nchunk = (nrow + PATTERN_CHUNK - 1) / PATTERN_CHUNK;
@@ -325,8 +320,9 @@ static fcm_status product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fc
   for (fcm_index c = 0; c < nchunk; c++)
     pending[c] = c;
   /* a first guess of each thread's share: A's entries and a quarter (A P has about as many) */
+  if (guess <= 0) guess = 5 * (Ap[nrow] / 4);
   for (int t = 0; t < nt; t++) {
-    w.cap[t] = (size_t)FCM_MAX(5 * (Ap[nrow] / 4) / nt, 4096);
+    w.cap[t] = (size_t)FCM_MAX(guess / nt, 4096);
     FCM_ALLOC_RAW(ctx, w.cap[t], w.buf[t]);
   }
   while (npending > 0) {
@@ -639,8 +635,9 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
     pnode[g] = (unsigned char)fcm__ptap_shifted3(3 * g, P_ptr, P_col, NULL, NULL);
   /* A P's rows unsorted: each entry of C takes one term from each row of A P it sums, wherever
    * that row holds the column, so C's values do not depend on the order (nor do A P's) */
-  FCM_TRY(ctx, product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr, P_col, nc,
-                               0, dup, pnode, closed, NULL, &t->AP_ptr, &t->AP_col));
+  FCM_TRY(ctx, fcm__ptap_product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr,
+                                         P_col, nc, 0, dup, pnode, closed, NULL, 0, &t->AP_ptr,
+                                         &t->AP_col));
   FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
   /* A P's groups of three rows of one pattern: those of A's (the same columns in the same
    * order, dup above) and any other whose rows agree */
@@ -654,8 +651,8 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   for (fcm_index g = 0; 3 * g + 2 < nc; g++)
     dup[3 * g + 1] = dup[3 * g + 2] =
         (unsigned char)fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
-  FCM_TRY(ctx, product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc, 1, dup,
-                               NULL, NULL, closed, &cp, &cc));
+  FCM_TRY(ctx, fcm__ptap_product_pattern(ctx, nt, nc, t->R_ptr, t->R_col, t->AP_ptr, t->AP_col, nc,
+                                         1, dup, NULL, NULL, closed, 0, &cp, &cc));
   FCM_TRY(ctx, fcm__ptap_finish(t, A, ap3, with_diagonal, &cp, &cc, C));
   *plan = t;
   t = NULL;

@@ -2,7 +2,6 @@
  * (fcm__ptap_create_from()): only the rows the cut changed are computed. */
 #include "la/ptap_impl.h"
 
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,6 +17,7 @@ typedef struct carry_work {
   const unsigned char *same3;         /* the new plan's */
   unsigned char *cdup;                /* per group of C's rows: R's rows shifted (their rows of
                                          A P of one pattern): one pattern before the diagonal */
+  unsigned char *pnode;               /* per node of P's rows: shifted per component */
   fcm_index n, nc;
 } carry_work;
 
@@ -47,43 +47,18 @@ static int carry_arow(const carry_work *w, fcm_index i)
   return 1;
 }
 
-/* Copy-graph mode (A_col NULL): are copy k's three rows of A the old copy's rows mapped (its
- * graph rows compared, a copy at a time), reaching only rows of P that are (prow)? */
+/* Copy-graph mode (A_col NULL): are copy k's three rows of A the old copy's rows mapped (the
+ * prior's copy_same: its graph rows compared by the caller), reaching only rows of P that are
+ * (prow)? */
 static int carry_acopy(const carry_work *w, fcm_index k)
 {
   const fcm__ptap_prior *pr = w->pr;
-  const fcm_index *ro = pr->row_old + 3 * k;
-  if (ro[0] < 0 || ro[0] % 3 != 0 || ro[1] != ro[0] + 1 || ro[2] != ro[0] + 2) return 0;
-  const fcm_index g = ro[0] / 3, deg = pr->A_ptr[g + 1] - pr->A_ptr[g];
-  if (pr->G_ptr[k + 1] - pr->G_ptr[k] != deg) return 0;
-  const fcm_index *adj = pr->A_adj + pr->A_ptr[g], *nadj = pr->G_adj + pr->G_ptr[k];
-  for (fcm_index q = 0; q < deg; q++) {
-    const fcm_index j = nadj[q], *rn = pr->row_new + 3 * adj[q];
-    if (rn[0] != 3 * j || rn[1] != 3 * j + 1 || rn[2] != 3 * j + 2 || !w->prow[3 * j] ||
-        !w->prow[3 * j + 1] || !w->prow[3 * j + 2])
-      return 0;
+  if (!pr->copy_same[k]) return 0;
+  for (fcm_index q = pr->G_ptr[k]; q < pr->G_ptr[k + 1]; q++) {
+    const fcm_index j = pr->G_adj[q];
+    if (!w->prow[3 * j] || !w->prow[3 * j + 1] || !w->prow[3 * j + 2]) return 0;
   }
   return 1;
-}
-
-/* Row i of the pattern of X Y the plain way (columns first reached, X's row order, then
- * Y's): the count, the columns into out (NULL: counted only), sorted when `sort`. Row i of A P
- * (X = A, Y = P), and row I of C (X = R, Y = A P, sorted; the diagonal is added afterwards,
- * as fcm__ptap_create() does). */
-static fcm_index carry_plain(const fcm_index *Xp, const int *Xc, const fcm_index *Yp, const int *Yc,
-                             fcm_index i, fcm_index *mk, fcm_index tag, int *out, int sort)
-{
-  fcm_index cnt = 0;
-  for (fcm_index p = Xp[i]; p < Xp[i + 1]; p++)
-    for (fcm_index q = Yp[Xc[p]]; q < Yp[Xc[p] + 1]; q++) {
-      const int j = Yc[q];
-      if (mk[j] == tag) continue;
-      mk[j] = tag;
-      if (out) out[cnt] = j;
-      cnt++;
-    }
-  if (out && sort) fcm__ptap_sort_ints(out, cnt);
-  return cnt;
 }
 
 /* Is row I of C the old row mapped: its row of R the old one mapped, every row of A P it
@@ -114,59 +89,108 @@ static int carry_c_taken(const carry_work *w, fcm_index I, int *out)
   return sorted;
 }
 
-/* The rows of A P (stage 0) or of C (stage 1): which are taken over, their counts (pass 0) and
- * columns (pass 1) into ptr / col, by nt threads, marks mk (nt x nc, -1 on the first call). */
-static void carry_rows(carry_work *w, int stage, int pass, fcm_index *ptr, int *col, fcm_index *mk,
-                       int nt)
+/* Is row i of A P (stage 0) or of C (stage 1) the row before's columns: A P's rows of a node
+ * of one pattern in A, C's rows of R's shifted rows (computed ones, before their diagonal)? */
+static int carry_dup(const carry_work *w, int stage, fcm_index i)
 {
-  const fcm_index nrow = stage ? w->nc : w->n, base = (2 * stage + pass) * (w->n + w->nc);
+  if (i % 3 == 0) return 0;
+  return stage ? w->cdup[i / 3] && !w->ckeep[i] && !w->ckeep[i - 1] : w->same3[i / 3];
+}
+
+/* The rows of A P (stage 0) or of C (stage 1): which are taken over (keep), and their columns
+ * into *ptr, *col (new arrays): the rows taken mapped, the rows repeating the row before
+ * copied, the others computed together by fcm__ptap_product_pattern() (the plain product's
+ * rows: columns first reached, X's row order, then Y's; C's sorted, their diagonal added
+ * afterwards as fcm__ptap_create() adds it) by nt threads. */
+static fcm_status carry_rows(fcm_ctx *ctx, carry_work *w, int stage, int nt, fcm_index **ptr_out,
+                             int **col_out)
+{
+  fcm_status st = FCM_OK;
+  const fcm_index nrow = stage ? w->nc : w->n;
+  const fcm_index *Xp = stage ? w->Rp : w->Ap, *Yp = stage ? w->APp : w->Pp;
+  const int *Xc = stage ? w->Rc : w->Ac, *Yc = stage ? w->APc : w->Pc;
   unsigned char *keep = stage ? w->ckeep : w->keep;
-  const unsigned char *dup3 = stage ? w->cdup : w->same3;
-#pragma omp parallel num_threads(nt) if (nt > 1 && nrow > 4096)
+  fcm_index *ptr = NULL, *from = NULL, *sp = NULL, *cp = NULL, nsub = 0, nx = 0, guess = 0;
+  int *col = NULL, *sc = NULL, *cc = NULL;
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 255) if (nt > 1 && nrow > 4096)
+  for (fcm_index i = 0; i < nrow; i++) /* chunks of whole nodes: row 3 k first */
+    keep[i] = (unsigned char)(stage          ? carry_crow(w, i)
+                              : w->pr->A_col ? carry_arow(w, i)
+                              : i % 3 == 0   ? i + 2 < nrow && carry_acopy(w, i / 3)
+                                             : keep[i - 1]);
+  /* the rows computed, as the rows of a matrix of X's rows */
+  FCM_ALLOC_RAW(ctx, nrow + 1, from); /* every entry written below */
+  for (fcm_index i = 0; i < nrow; i++) {
+    from[i] = -1;
+    if (keep[i] || carry_dup(w, stage, i)) continue;
+    from[i] = nsub++;
+    nx += Xp[i + 1] - Xp[i];
+  }
   {
-    fcm_index *m = mk + (size_t)omp_get_thread_num() * (size_t)(w->nc + 1);
-    /* chunks of whole nodes: a node's rows 3 k + 1, 3 k + 2 follow row 3 k in one thread */
-#pragma omp for schedule(dynamic, 255)
-    for (fcm_index i = 0; i < nrow; i++) {
-      if (!pass && stage) keep[i] = (unsigned char)carry_crow(w, i);
-      if (!pass && !stage)
-        keep[i] = (unsigned char)(w->pr->A_col ? carry_arow(w, i)
-                                  : i % 3 == 0 ? i + 2 < nrow && carry_acopy(w, i / 3)
-                                               : keep[i - 1]);
-      /* the row before's columns: A P's rows of a node of one pattern in A, C's rows of R's
-       * shifted rows (computed ones, before their diagonal) */
-      if (i % 3 != 0 && dup3[i / 3] && (!stage || (!keep[i] && !keep[i - 1]))) {
-        if (!pass) ptr[i + 1] = ptr[i];
-        if (pass)
-          memcpy(col + ptr[i], col + ptr[i - 1], sizeof *col * (size_t)(ptr[i] - ptr[i - 1]));
-        continue;
-      }
-      const fcm_index io = stage ? w->pr->crow_old[i] : w->pr->row_old[i];
-      int *out = pass ? col + ptr[i] : NULL;
-      if (keep[i] && !stage) {
-        const fcm_index *op = w->old->AP_ptr;
-        const fcm_index len = op[io + 1] - op[io];
-        for (fcm_index q = 0; q < len && out; q++)
-          out[q] = (int)w->pr->crow_new[w->old->AP_col[op[io] + q]];
-        if (!pass) ptr[i + 1] = len;
-      } else if (keep[i]) {
-        const fcm_index *op = fcm_csr_row_ptr(w->pr->C);
-        if (out) {
-          const int sorted = carry_c_taken(w, i, out);
-          if (w->csame) w->csame[i] = (unsigned char)sorted;
-        }
-        if (!pass) ptr[i + 1] = op[io + 1] - op[io];
-      } else {
-        const fcm_index cnt =
-            stage ? carry_plain(w->Rp, w->Rc, w->APp, w->APc, i, m, base + i, out, 1)
-                  : carry_plain(w->Ap, w->Ac, w->Pp, w->Pc, i, m, base + i, out, 0);
-        if (!pass) ptr[i + 1] = cnt;
-      }
+    /* their entries expected: the old rows' mean and a quarter (the threads' first buffers) */
+    const fcm_index *op = stage ? fcm_csr_row_ptr(w->pr->C) : w->old->AP_ptr;
+    const fcm_index on = stage ? w->old->nc : w->old->n;
+    guess = on > 0 ? 5 * (op[on] / on + 1) * nsub / 4 : 0;
+  }
+  FCM_ALLOC(ctx, nsub + 1, sp);
+  FCM_ALLOC_RAW(ctx, nx + 1, sc); /* every entry written below */
+  for (fcm_index i = 0, s = 0; i < nrow; i++) {
+    if (from[i] < 0) continue;
+    const fcm_index len = Xp[i + 1] - Xp[i];
+    memcpy(sc + sp[s], Xc + Xp[i], sizeof *sc * (size_t)len);
+    sp[s + 1] = sp[s] + len;
+    s++;
+  }
+  FCM_TRY(ctx, fcm__ptap_product_pattern(ctx, nt, nsub, sp, sc, Yp, Yc, w->nc, stage, NULL,
+                                         stage ? NULL : w->pnode, NULL, NULL, guess, &cp, &cc));
+  FCM_ALLOC_RAW(ctx, nrow + 1, ptr); /* every entry written below */
+  ptr[0] = 0;
+  for (fcm_index i = 0; i < nrow; i++) {
+    fcm_index len = 0;
+    if (from[i] >= 0) {
+      len = cp[from[i] + 1] - cp[from[i]];
+    } else if (carry_dup(w, stage, i)) {
+      len = ptr[i] - ptr[i - 1];
+    } else if (stage) {
+      const fcm_index *op = fcm_csr_row_ptr(w->pr->C), io = w->pr->crow_old[i];
+      len = op[io + 1] - op[io];
+    } else {
+      const fcm_index *op = w->old->AP_ptr, io = w->pr->row_old[i];
+      len = op[io + 1] - op[io];
+    }
+    ptr[i + 1] = ptr[i] + len;
+  }
+  FCM_ALLOC_RAW(ctx, ptr[nrow] + 1, col); /* every entry written below */
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 255) if (nt > 1 && nrow > 4096)
+  for (fcm_index i = 0; i < nrow; i++) { /* the row before in the same chunk */
+    int *out = col + ptr[i];
+    const fcm_index len = ptr[i + 1] - ptr[i];
+    if (from[i] >= 0) {
+      memcpy(out, cc + cp[from[i]], sizeof *out * (size_t)len);
+    } else if (carry_dup(w, stage, i)) {
+      memcpy(out, col + ptr[i - 1], sizeof *out * (size_t)len);
+    } else if (stage) {
+      const int sorted = carry_c_taken(w, i, out);
+      if (w->csame) w->csame[i] = (unsigned char)sorted;
+    } else {
+      const fcm_index *op = w->old->AP_ptr;
+      const int *oc = w->old->AP_col + op[w->pr->row_old[i]];
+      const fcm_index *cn = w->pr->crow_new;
+      for (fcm_index q = 0; q < len; q++)
+        out[q] = (int)cn[oc[q]];
     }
   }
-  if (!pass)
-    for (fcm_index i = 0; i < nrow; i++)
-      ptr[i + 1] += ptr[i];
+  *ptr_out = ptr, *col_out = col;
+  ptr = NULL, col = NULL;
+cleanup:
+  fcm__free(ctx, ptr);
+  fcm__free(ctx, col);
+  fcm__free(ctx, from);
+  fcm__free(ctx, sp);
+  fcm__free(ctx, sc);
+  fcm__free(ctx, cp);
+  fcm__free(ctx, cc);
+  return st;
 }
 
 fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, const fcm_csr *A,
@@ -176,7 +200,7 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
 {
   fcm_status st = FCM_OK;
   fcm__ptap *t = NULL;
-  fcm_index *cp = NULL, *mk = NULL;
+  fcm_index *cp = NULL;
   int *cc = NULL;
   unsigned char *ap3 = NULL;
   carry_work w = {.pr = prior, .nc = nc};
@@ -185,12 +209,13 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
             "ptap_create_from: NULL argument, P_ptr[0] != 0, nc = %lld < 0 or nt = %d < 1",
             (long long)nc, nt);
   {
-    const char *missing = !prior->plan                                        ? "plan"
-                          : !prior->C                                         ? "C"
-                          : !prior->A_ptr                                     ? "A_ptr"
-                          : !prior->A_col && !prior->A_adj                    ? "A_col or A_adj"
-                          : !prior->A_col && (!prior->G_ptr || !prior->G_adj) ? "G_ptr / G_adj"
-                          : !prior->row_old || !prior->row_new                ? "row_old / row_new"
+    const char *missing = !prior->plan                     ? "plan"
+                          : !prior->C                      ? "C"
+                          : !prior->A_ptr                  ? "A_ptr"
+                          : !prior->A_col && !prior->A_adj ? "A_col or A_adj"
+                          : !prior->A_col && (!prior->G_ptr || !prior->G_adj || !prior->copy_same)
+                              ? "G_ptr / G_adj / copy_same"
+                          : !prior->row_old || !prior->row_new   ? "row_old / row_new"
                           : !prior->crow_old || !prior->crow_new ? "crow_old / crow_new"
                                                                  : NULL;
     FCM_CHECK(!missing, ctx, FCM_ERR_ARG, "ptap_create_from: the prior's %s is NULL", missing);
@@ -208,9 +233,7 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   FCM_ALLOC(ctx, n + 1, w.prow);
   FCM_ALLOC(ctx, n + 1, w.keep);
   FCM_ALLOC(ctx, nc + 1, w.ckeep);
-  FCM_ALLOC_RAW(ctx, (size_t)nt * (size_t)(nc + 1), mk);
-  for (size_t j = 0; j < (size_t)nt * (size_t)(nc + 1); j++)
-    mk[j] = -1;
+  FCM_ALLOC(ctx, n / 3 + 1, w.pnode);
   w.same3 = t->same3;
 #pragma omp parallel num_threads(nt) if (nt > 1 && n > 4096)
   {
@@ -218,16 +241,15 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
      * caller guarantees: fcm__mg_create_pattern_cut() checks that A has its space's pattern),
      * so a copy's three rows hold one pattern */
 #pragma omp for schedule(static) nowait
-    for (fcm_index g = 0; g < n / 3; g++)
+    for (fcm_index g = 0; g < n / 3; g++) {
       t->same3[g] = (unsigned char)(!prior->A_col || fcm__ptap_same_pattern3(3 * g, w.Ap, w.Ac));
+      w.pnode[g] = (unsigned char)fcm__ptap_shifted3(3 * g, P_ptr, P_col, NULL, NULL);
+    }
 #pragma omp for schedule(static)
     for (fcm_index i = 0; i < n; i++)
       w.prow[i] = (unsigned char)carry_prow(&w, i);
   }
-  FCM_ALLOC(ctx, n + 1, t->AP_ptr);
-  carry_rows(&w, 0, 0, t->AP_ptr, NULL, mk, nt);
-  FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_col); /* every entry written below */
-  carry_rows(&w, 0, 1, t->AP_ptr, t->AP_col, mk, nt);
+  FCM_TRY(ctx, carry_rows(ctx, &w, 0, nt, &t->AP_ptr, &t->AP_col));
   FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
   FCM_ALLOC(ctx, n / 3 + 1, ap3);
 #pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && n > 4096)
@@ -237,10 +259,7 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
   FCM_ALLOC(ctx, nc / 3 + 1, w.cdup);
   for (fcm_index g = 0; 3 * g + 2 < nc; g++)
     w.cdup[g] = (unsigned char)fcm__ptap_shifted3(3 * g, t->R_ptr, t->R_col, NULL, ap3);
-  FCM_ALLOC(ctx, nc + 1, cp);
-  carry_rows(&w, 1, 0, cp, NULL, mk, nt);
-  FCM_ALLOC_RAW(ctx, cp[nc] + 1, cc);
-  carry_rows(&w, 1, 1, cp, cc, mk, nt);
+  FCM_TRY(ctx, carry_rows(ctx, &w, 1, nt, &cp, &cc));
   /* the rows taken hold theirs (the prior's plan was made with the same with_diagonal) */
   FCM_TRY(ctx, fcm__ptap_finish(t, A, ap3, with_diagonal, &cp, &cc, C));
   if (taken) {
@@ -257,7 +276,7 @@ cleanup:
   fcm__free(ctx, w.csame);
   fcm__free(ctx, cp);
   fcm__free(ctx, cc);
-  fcm__free(ctx, mk);
+  fcm__free(ctx, w.pnode);
   fcm__free(ctx, ap3);
   fcm__free(ctx, w.prow);
   fcm__free(ctx, w.keep);

@@ -33,6 +33,20 @@ fcm_status fcm__ptap_transpose_pattern(fcm_ctx *ctx, fcm_index n, fcm_index nc,
                                        const fcm_index *P_ptr, const int *P_col,
                                        const double *P_val, fcm_index **R_ptr, int **R_col,
                                        double **R_val);
+/* Pattern of C = A B (nrow rows of A, ncol columns of B), each row's columns sorted when
+ * `sorted`, else in the order first reached (A's row order, then B's; the same for any thread
+ * count); dup (NULL: none) flags the rows whose pattern is the row before's (A's rows and the
+ * rows of B they reach giving the same columns in the same order), which are copied instead
+ * of computed; bnode (NULL: none) the nodes whose rows of B are shifted per component, the
+ * rows of C found a node at a time recorded in `closed` (NULL: not recorded; nrow bytes);
+ * bclosed (NULL: none) such rows of B. `guess`: the entries of C expected (0: A's and a
+ * quarter), the threads' first buffers. *Cp_out, *Cc_out new arrays. */
+fcm_status fcm__ptap_product_pattern(fcm_ctx *ctx, int nt, fcm_index nrow, const fcm_index *Ap,
+                                     const int *Ac, const fcm_index *Bp, const int *Bc,
+                                     fcm_index ncol, int sorted, const unsigned char *dup,
+                                     const unsigned char *bnode, unsigned char *closed,
+                                     const unsigned char *bclosed, fcm_index guess,
+                                     fcm_index **Cp_out, int **Cc_out);
 /* The missing diagonal entries inserted into a square pattern with sorted rows. */
 fcm_status fcm__ptap_add_diagonal(fcm_ctx *ctx, fcm_index n, fcm_index **ptr, int **col);
 /* Whether rows i, i + 1, i + 2 hold one pattern. */

@@ -76,6 +76,63 @@ int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple)
   return ok;
 }
 
+int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag)
+{
+  const fcm_space *sp = m->pattern_of;
+  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
+      m->lev[0].n != 3 * sp->num_local_copies)
+    return 0;
+  const fcm_index nk = sp->num_local_copies, *rp = sp->row_ptr;
+  int ok = 1;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
+    if (nk > 4096)
+  for (fcm_index k = 0; k < nk; k++) {
+    fcm_index lo = sp->node_ptr[k], hi = sp->node_ptr[k + 1];
+    while (lo < hi) {
+      const fcm_index mid = lo + (hi - lo) / 2;
+      if (sp->node_adj[mid] < k)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    /* the row's columns are the graph row's copies' three each (the space's pattern), so
+     * its length and k's place in the graph row tell where column i lies (the columns are
+     * not read: a cache miss a row) */
+    const fcm_index deg = sp->node_ptr[k + 1] - sp->node_ptr[k], q = lo - sp->node_ptr[k];
+    const int own = lo < sp->node_ptr[k + 1] && sp->node_adj[lo] == k;
+    for (fcm_index c = 0; c < 3; c++) {
+      const fcm_index i = 3 * k + c;
+      const int found = own && rp[i + 1] - rp[i] == 3 * deg;
+      ok = ok && found;
+      diag[i] = found ? rp[i] + 3 * q + c : -1;
+    }
+  }
+  return ok;
+}
+
+int fcm__mg_space_reach(const fcm_mg *m, fcm_index *reach)
+{
+  const fcm_space *sp = m->pattern_of;
+  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
+      m->lev[0].n != 3 * sp->num_local_copies)
+    return 0;
+  const fcm_index nk = sp->num_local_copies, *rp = sp->row_ptr;
+  int ok = 1;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
+    if (nk > 4096)
+  for (fcm_index k = 0; k < nk; k++) {
+    /* the last column: the graph row's last copy's third (its columns are not read) */
+    const fcm_index deg = sp->node_ptr[k + 1] - sp->node_ptr[k];
+    const fcm_index last = deg > 0 ? 3 * sp->node_adj[sp->node_ptr[k + 1] - 1] + 2 : -1;
+    for (fcm_index c = 0; c < 3; c++) {
+      const fcm_index i = 3 * k + c;
+      ok = ok && rp[i + 1] - rp[i] == 3 * deg;
+      reach[i] = FCM_MAX(i, last);
+    }
+  }
+  return ok;
+}
+
 void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
 {
   for (int l = 0; l < MG_MAX_LEVELS; l++) {
@@ -83,6 +140,8 @@ void fcm__mg_carry_free(fcm_ctx *ctx, mg_carry *c)
     fcm__free(ctx, c->row_new[l]);
     fcm__free(ctx, c->crow_same[l]);
   }
+  fcm__free(ctx, c->copy_same);
+  c->copy_same = NULL;
   memset(c->crow_same, 0, sizeof c->crow_same);
   memset(c->row_old, 0, sizeof c->row_old);
   memset(c->row_new, 0, sizeof c->row_new);
@@ -130,6 +189,20 @@ cleanup:
   return st;
 }
 
+/* Are copy k's three rows of level 0's matrix the old copy's rows mapped, column for column
+ * in the same order (the copy graphs' rows: old graph[0], graph[1]; new graph[2], graph[3])? */
+static int same_copy_rows(const mg_carry *c, fcm_index k)
+{
+  const fcm_index *ro = c->row_old[0] + 3 * k, *rn = c->row_new[0];
+  if (ro[0] < 0 || ro[0] % 3 != 0 || ro[1] != ro[0] + 1 || ro[2] != ro[0] + 2) return 0;
+  const fcm_index g = ro[0] / 3, deg = c->graph[0][g + 1] - c->graph[0][g];
+  if (c->graph[2][k + 1] - c->graph[2][k] != deg) return 0;
+  const fcm_index *adj = c->graph[1] + c->graph[0][g], *nadj = c->graph[3] + c->graph[2][k];
+  for (fcm_index q = 0; q < deg; q++)
+    if (rn[3 * adj[q]] != 3 * nadj[q]) return 0; /* the DOFs of a copy map together */
+  return 1;
+}
+
 fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c)
 {
   fcm_status st = FCM_OK;
@@ -150,6 +223,10 @@ fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c)
     c->row_old[0][i] = k >= 0 ? 3 * k + i % 3 : -1;
     if (k >= 0) c->row_new[0][3 * k + i % 3] = i;
   }
+  FCM_ALLOC_RAW(ctx, n / 3 + 1, c->copy_same); /* every entry written below */
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n / 3 > 4096)
+  for (fcm_index k = 0; k < n / 3; k++)
+    c->copy_same[k] = (unsigned char)same_copy_rows(c, k);
   c->nlev = 1;
   const int nl = FCM_MIN(m->nlev, old->nlev);
   for (int l = 0; l + 1 < nl; l++) {
@@ -160,20 +237,6 @@ fcm_status fcm__mg_carry_maps(fcm_mg *m, mg_carry *c)
 cleanup:
   fcm__free(ctx, old_copy);
   return st;
-}
-
-/* Are copy k's three rows of level 0's matrix the old copy's rows mapped, column for column
- * in the same order (the copy graphs' rows: old graph[0], graph[1]; new graph[2], graph[3])? */
-static int same_copy_rows(const mg_carry *c, fcm_index k)
-{
-  const fcm_index *ro = c->row_old[0] + 3 * k, *rn = c->row_new[0];
-  if (ro[0] < 0 || ro[0] % 3 != 0 || ro[1] != ro[0] + 1 || ro[2] != ro[0] + 2) return 0;
-  const fcm_index g = ro[0] / 3, deg = c->graph[0][g + 1] - c->graph[0][g];
-  if (c->graph[2][k + 1] - c->graph[2][k] != deg) return 0;
-  const fcm_index *adj = c->graph[1] + c->graph[0][g], *nadj = c->graph[3] + c->graph[2][k];
-  for (fcm_index q = 0; q < deg; q++)
-    if (rn[3 * adj[q]] != 3 * nadj[q]) return 0; /* the DOFs of a copy map together */
-  return 1;
 }
 
 fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
@@ -192,8 +255,8 @@ fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
   FCM_ALLOC_RAW(ctx, nk + 1, same); /* every entry written below */
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nk > 4096)
   for (fcm_index k = 0; k < nk; k++)
-    same[k] = (unsigned char)(l == 0 ? same_copy_rows(c, k)
-                                     : cs[3 * k] && cs[3 * k + 1] && cs[3 * k + 2]);
+    same[k] =
+        (unsigned char)(l == 0 ? c->copy_same[k] : cs[3 * k] && cs[3 * k + 1] && cs[3 * k + 2]);
   pr->old = c->old->lev[l].blk;
   pr->row_old = c->row_old[l];
   pr->same = same;
@@ -214,6 +277,7 @@ int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_pri
   if (l == 0) {
     pr->A_ptr = c->graph[0], pr->A_adj = c->graph[1];
     pr->G_ptr = c->graph[2], pr->G_adj = c->graph[3];
+    pr->copy_same = c->copy_same;
   } else {
     pr->A_ptr = fcm_csr_row_ptr(O->Aown), pr->A_col = fcm_csr_col_idx(O->Aown);
   }

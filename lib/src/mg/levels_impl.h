@@ -380,6 +380,8 @@ typedef struct mg_carry {
   const fcm_index *graph[4];               /* fcm__space_cut_copy_map()'s */
   unsigned char *crow_same[MG_MAX_LEVELS]; /* level l >= 1: its rows that are the old ones
                                               mapped in the same order (the plans' c_same) */
+  unsigned char *copy_same; /* level 0, per copy: its three rows the old copy's mapped, column
+                               for column in the same order (the copy graphs compared) */
 } mg_carry;
 
 /* The space when A has the space's pattern (row_ptr and col_idx the space's arrays, shared,
@@ -407,6 +409,18 @@ fcm_status fcm__mg_carry_blocks_prior(const fcm_mg *m, const mg_carry *c, int l,
  * FCM__MG_TRIPLE_NODES, as fcm__mg_row_slabs() finds them from the rows. 1 when written, 0
  * (triple unfinished) where that does not apply. */
 int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple);
+
+/* Level 0's diagonal positions (diag, n entries) from the space's copy graph where level 0's
+ * matrix has the space's pattern, as fcm__mg_space_triples() reads it: copy k's row 3 k + c
+ * holds its diagonal at 3 q + c, q the place of k in its graph row (each row's length
+ * checked, 3 per graph entry). 1 when written, 0 (diag unfinished) where that does not apply
+ * or a check fails. */
+int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag);
+
+/* Level 0's rows' reach (reach, n entries: the larger of the row and its last column) from
+ * the space's copy graph, as fcm__mg_space_diag() reads it. 1 when written, 0 (reach
+ * unfinished) where that does not apply or a row's length is not 3 per graph entry. */
+int fcm__mg_space_reach(const fcm_mg *m, fcm_index *reach);
 
 /* The prior of level l's Galerkin plan (1), or 0 where c (NULL: none) has none. */
 int fcm__mg_carry_prior(const fcm_mg *m, const mg_carry *c, int l, fcm__ptap_prior *pr);

@@ -123,6 +123,7 @@ static fcm_status level_diag(fcm_mg *m, mg_level *L)
   if (!L->dinv) FCM_ALLOC(ctx, L->n + 1, L->dinv);
   const fcm_index n = L->n;
   fcm_index bad = n; /* the first row without one */
+  if (L == &m->lev[0] && fcm__mg_space_diag(m, L->diag)) goto cleanup;
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static)                             \
     reduction(min                                                                                  \
               : bad) if (n > 4096)

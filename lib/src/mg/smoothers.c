@@ -234,10 +234,12 @@ fcm_status fcm__mg_row_slabs(fcm_mg *m, mg_level *L)
   FCM_ALLOC_RAW(ctx, L->n + 1, work);
   FCM_ALLOC_RAW(ctx, L->n + 1, reach);
   const fcm_index n = L->n;
+  /* level 0 on its space's pattern: the copy graph gives the last columns */
+  const int by_space = L == &m->lev[0] && fcm__mg_space_reach(m, reach);
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
   for (fcm_index i = 0; i < n; i++) { /* a row's columns ascend: its last reaches furthest */
     work[i] = (double)(rp[i + 1] - rp[i]);
-    reach[i] = rp[i + 1] > rp[i] ? FCM_MAX(i, (fcm_index)ci[rp[i + 1] - 1]) : i;
+    if (!by_space) reach[i] = rp[i + 1] > rp[i] ? FCM_MAX(i, (fcm_index)ci[rp[i + 1] - 1]) : i;
   }
   FCM_TRY(ctx, slabs_create(ctx, L->n, NULL, reach, work, MG_ROW_SLABS_THICK, &L->rows));
   row_slabs_lead(L->n, reach, work, &L->rows);
