@@ -318,13 +318,23 @@ fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr
 
 struct mg_carry;
 
-/* The block smoothers of every level but the coarsest, from the current level matrices;
- * with `old` (NULL: none), a level l with same[l] (its pattern is old's) takes old's block
- * smoother where its blocks are old's (fcm__mg_keep_blocks()); with `carry` (NULL: none; its
- * maps made), level 0's blocks that are the old hierarchy's mapped copy their positions
- * (fcm__mg_carry_blocks_prior()). */
+/* The block smoother of level l (< nlev - 1), from its level matrix (its row order made
+ * before, fcm__mg_row_slabs(), with the SGS smoother); with `old` (NULL: none) and same[l]
+ * (level l's pattern is old's) old's block smoother where its blocks are old's
+ * (fcm__mg_keep_blocks()); with `carry` (NULL: none; its maps made), the blocks that are the
+ * old hierarchy's mapped copy their positions (fcm__mg_carry_blocks_prior()). *bmax: its
+ * largest block, *carried: its blocks carried. Writes level l's fields only. */
+fcm_status fcm__mg_level_block_smoother(fcm_mg *m, fcm_mg *old, const unsigned char *same,
+                                        const struct mg_carry *carry, int l, fcm_index *bmax,
+                                        fcm_index *carried);
+
+/* The block smoothers of the levels from `first` on but the coarsest
+ * (fcm__mg_level_block_smoother()), m->blk_max and m->kept.carried_blocks counted. */
 fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same,
-                                          const struct mg_carry *carry);
+                                          const struct mg_carry *carry, int first);
+
+/* The block sweeps' buffers, m->blk_max entries per thread (after every block smoother). */
+fcm_status fcm__mg_block_buffers(fcm_mg *m);
 
 /* ---- sweeps.c */
 

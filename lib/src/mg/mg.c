@@ -268,13 +268,40 @@ cleanup:
   return st;
 }
 
-/* The levels' Galerkin plans and patterns, row orders and the coarsest analysis (keeping
- * old's where fcm__mg_create_from() may; same[l]: level l's pattern is old's). */
-static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, mg_carry *carry, unsigned char *same)
+/* Level L's smoothing order: its rows' colours or slabs (the smoother's), unless kept. */
+static fcm_status level_orders(fcm_mg *m, mg_level *L)
+{
+  fcm_status st = FCM_OK;
+  if (m->opts.smoother == FCM_MG_SMOOTHER_SGS_COLORED && !L->color_ptr)
+    FCM_TRY(m->ctx, fcm__mg_level_colors(m, L));
+  if (m->opts.smoother == FCM_MG_SMOOTHER_SGS && !L->rows.ptr)
+    FCM_TRY(m->ctx, fcm__mg_row_slabs(m, L));
+cleanup:
+  return st;
+}
+
+/* Level 0's smoothing order and block smoother (block_smoothing) of a cut's hierarchy;
+ * *bmax, *carried as fcm__mg_level_block_smoother() gives them (0 without blocks). */
+static fcm_status level0_smoothers(fcm_mg *m, const mg_carry *carry, fcm_index *bmax,
+                                   fcm_index *carried)
+{
+  fcm_status st = FCM_OK;
+  *bmax = *carried = 0;
+  FCM_TRY(m->ctx, level_orders(m, &m->lev[0]));
+  if (m->opts.block_smoothing)
+    FCM_TRY(m->ctx, fcm__mg_level_block_smoother(m, NULL, NULL, carry, 0, bmax, carried));
+cleanup:
+  return st;
+}
+
+/* The levels' Galerkin plans and patterns, the row orders of the levels from `first` on and
+ * the coarsest analysis (keeping old's where fcm__mg_create_from() may; same[l]: level l's
+ * pattern is old's). */
+static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, mg_carry *carry, unsigned char *same,
+                                  int first)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
-  const fcm_mg_options o = m->opts;
   int kept_above = 0; /* the plan of the finer level was kept: this level's pattern is old's */
   for (int l = 0; l < m->nlev; l++) {
     mg_level *L = &m->lev[l];
@@ -289,18 +316,50 @@ static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, mg_carry *carry, unsig
     if (l + 1 < m->nlev && !kept_above) FCM_TRY(ctx, galerkin_pattern(m, l, carry));
     if (same[l]) fcm__mg_keep_orders(old, m, l);
   }
-  if (o.smoother == FCM_MG_SMOOTHER_SGS_COLORED)
-    for (int l = 0; l + 1 < m->nlev; l++)
-      if (!m->lev[l].color_ptr) FCM_TRY(ctx, fcm__mg_level_colors(m, &m->lev[l]));
-  if (o.smoother == FCM_MG_SMOOTHER_SGS)
-    for (int l = 0; l + 1 < m->nlev; l++)
-      if (!m->lev[l].rows.ptr) FCM_TRY(ctx, fcm__mg_row_slabs(m, &m->lev[l]));
+  for (int l = first; l + 1 < m->nlev; l++)
+    FCM_TRY(ctx, level_orders(m, &m->lev[l]));
   if (!(old && fcm__mg_keep_analysis(old, m, same[m->nlev - 1]))) {
     if (old) fcm_direct_destroy(&old->direct); /* not taken: freed first, as above */
     mg_level *Lc = &m->lev[m->nlev - 1];
     FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, fcm__mg_level_matrix(Lc), &m->direct));
     FCM_TRY(ctx, fcm_direct_analyze(m->direct));
   }
+cleanup:
+  return st;
+}
+
+/* A cut's patterns and smoothers (mg_create() from a carry, nothing of an old hierarchy kept,
+ * the values pending): level 0's smoothing order and block smoother read only level 0's
+ * pattern and diagonal, its grid and the carry's maps, and write level 0's own fields, so
+ * they are made as a task beside the coarser levels' patterns, orders and smoothers and the
+ * coarsest analysis: a thread of the team the cut runs on takes it when it is free
+ * (scene/run.c cut_parts()), else this one after the rest. The same bits either way; an
+ * error is the coarser levels' before level 0's. */
+static fcm_status create_beside(fcm_mg *m, mg_carry *carry, unsigned char *same)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  fcm__loop L;
+  fcm_index bmax = 0, carried = 0;
+  fcm__loop_begin(ctx, &L);
+#pragma omp task default(shared)
+  {
+    fcm__loop_iter it;
+    fcm__loop_enter(&L, &it, 1);
+    fcm__loop_leave(&L, &it, level0_smoothers(m, carry, &bmax, &carried));
+  }
+  {
+    fcm__loop_iter it;
+    fcm__loop_enter(&L, &it, 0);
+    fcm_status s = create_patterns(m, NULL, carry, same, 1);
+    if (s == FCM_OK && m->opts.block_smoothing)
+      s = fcm__mg_block_smoothers_create(m, NULL, same, carry, 1);
+    fcm__loop_leave(&L, &it, s);
+  }
+#pragma omp taskwait
+  FCM_TRY(ctx, fcm__loop_end(&L, NULL));
+  m->blk_max = FCM_MAX(m->blk_max, bmax);
+  m->kept.carried_blocks += carried;
 cleanup:
   return st;
 }
@@ -339,10 +398,15 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   if (!fcm__mg_reuse_allowed(old, m)) old = NULL;
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
   if (carry && carry->old) FCM_TRY(ctx, fcm__mg_carry_maps(m, carry));
-  FCM_TRY(ctx, create_patterns(m, old, carry, same));
-  if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));
-  if (o.block_smoothing) /* set up as created, or by the fcm_mg_setup() to come */
-    FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same, carry));
+  if (carry && carry->old && !old && m->values_pending && m->nlev > 1) {
+    FCM_TRY(ctx, create_beside(m, carry, same));
+  } else {
+    FCM_TRY(ctx, create_patterns(m, old, carry, same, 0));
+    if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));
+    if (o.block_smoothing) /* set up as created, or by the fcm_mg_setup() to come */
+      FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same, carry, 0));
+  }
+  if (o.block_smoothing) FCM_TRY(ctx, fcm__mg_block_buffers(m));
   *mg = m;
   m = NULL;
 cleanup:

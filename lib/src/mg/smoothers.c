@@ -669,47 +669,65 @@ fcm_status fcm__mg_level_blocks(fcm_mg *m, int l, fcm_index *nb, fcm_index **ptr
   return blocks_coarse(m, &m->lev[l], nb, ptr, dofs);
 }
 
-fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same,
-                                          const struct mg_carry *carry)
+fcm_status fcm__mg_level_block_smoother(fcm_mg *m, fcm_mg *old, const unsigned char *same,
+                                        const struct mg_carry *carry, int l, fcm_index *bmax,
+                                        fcm_index *carried)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
   fcm_index nb = 0, *ptr = NULL, *dofs = NULL;
   unsigned char *rows_same = NULL;
   fcm__schwarz_prior prior;
-  for (int l = 0; l + 1 < m->nlev; l++) {
-    mg_level *L = &m->lev[l];
-    int has_prior = 0;
-    FCM_FREE(ctx, rows_same);
-    if (m->values_pending)
-      FCM_TRY(ctx, fcm__mg_carry_blocks_prior(m, carry, l, &prior, &rows_same, &has_prior));
-    FCM_TRY(ctx, fcm__mg_level_blocks(m, l, &nb, &ptr, &dofs));
-    for (fcm_index k = 0; k < nb; k++)
-      m->blk_max = FCM_MAX(m->blk_max, ptr[k + 1] - ptr[k]);
-    int kept = 0;
-    if (nb > 0 && old && same[l])
-      FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
-    if (nb > 0 && !kept) {
-      if (m->values_pending) { /* the row order's flags spare the scans' comparisons */
-        FCM_TRY(ctx, fcm__schwarz_create_blocks_pattern(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs,
-                                                        L->rows.triple, has_prior ? &prior : NULL,
-                                                        &L->blk));
-        m->kept.carried_blocks += fcm__schwarz_carried(L->blk);
-      } else {
-        FCM_TRY(ctx,
-                fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
-      }
-      FCM_TRY(ctx, block_slabs(m, L));
+  mg_level *L = &m->lev[l];
+  int has_prior = 0, kept = 0;
+  *bmax = *carried = 0;
+  if (m->values_pending)
+    FCM_TRY(ctx, fcm__mg_carry_blocks_prior(m, carry, l, &prior, &rows_same, &has_prior));
+  FCM_TRY(ctx, fcm__mg_level_blocks(m, l, &nb, &ptr, &dofs));
+  for (fcm_index k = 0; k < nb; k++)
+    *bmax = FCM_MAX(*bmax, ptr[k + 1] - ptr[k]);
+  if (nb > 0 && old && same[l]) FCM_TRY(ctx, fcm__mg_keep_blocks(old, m, l, nb, ptr, dofs, &kept));
+  if (nb > 0 && !kept) {
+    if (m->values_pending) { /* the row order's flags spare the scans' comparisons */
+      FCM_TRY(ctx, fcm__schwarz_create_blocks_pattern(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs,
+                                                      L->rows.triple, has_prior ? &prior : NULL,
+                                                      &L->blk));
+      *carried = fcm__schwarz_carried(L->blk);
+    } else {
+      FCM_TRY(ctx,
+              fcm__schwarz_create_blocks(ctx, fcm__mg_level_matrix(L), nb, ptr, dofs, &L->blk));
     }
-    FCM_FREE(ctx, ptr);
-    FCM_FREE(ctx, dofs);
+    FCM_TRY(ctx, block_slabs(m, L));
   }
-  FCM_ALLOC(ctx, (size_t)m->nt * (size_t)m->blk_max + 1, m->blk_r);
-  FCM_ALLOC(ctx, (size_t)m->nt * (size_t)m->blk_max + 1, m->blk_dx);
 cleanup:
   fcm__free(ctx, ptr);
   fcm__free(ctx, dofs);
   fcm__free(ctx, rows_same);
+  return st;
+}
+
+fcm_status fcm__mg_block_smoothers_create(fcm_mg *m, fcm_mg *old, const unsigned char *same,
+                                          const struct mg_carry *carry, int first)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  for (int l = first; l + 1 < m->nlev; l++) {
+    fcm_index bmax = 0, carried = 0;
+    FCM_TRY(ctx, fcm__mg_level_block_smoother(m, old, same, carry, l, &bmax, &carried));
+    m->blk_max = FCM_MAX(m->blk_max, bmax);
+    m->kept.carried_blocks += carried;
+  }
+cleanup:
+  return st;
+}
+
+fcm_status fcm__mg_block_buffers(fcm_mg *m)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  FCM_ALLOC(ctx, (size_t)m->nt * (size_t)m->blk_max + 1, m->blk_r);
+  FCM_ALLOC(ctx, (size_t)m->nt * (size_t)m->blk_max + 1, m->blk_dx);
+cleanup:
   return st;
 }
 
