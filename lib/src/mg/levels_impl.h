@@ -323,7 +323,8 @@ struct mg_carry;
  * (level l's pattern is old's) old's block smoother where its blocks are old's
  * (fcm__mg_keep_blocks()); with `carry` (NULL: none; its maps made), the blocks that are the
  * old hierarchy's mapped copy their positions (fcm__mg_carry_blocks_prior()). *bmax: its
- * largest block, *carried: its blocks carried. Writes level l's fields only. */
+ * largest block, *carried: its blocks carried. With old NULL it writes level l's fields
+ * only (fcm__mg_keep_blocks() counts in m and moves old's). */
 fcm_status fcm__mg_level_block_smoother(fcm_mg *m, fcm_mg *old, const unsigned char *same,
                                         const struct mg_carry *carry, int l, fcm_index *bmax,
                                         fcm_index *carried);

@@ -333,8 +333,8 @@ cleanup:
  * pattern and diagonal, its grid and the carry's maps, and write level 0's own fields, so
  * they are made as a task beside the coarser levels' patterns, orders and smoothers and the
  * coarsest analysis: a thread of the team the cut runs on takes it when it is free
- * (scene/run.c cut_parts()), else this one after the rest. The same bits either way; an
- * error is the coarser levels' before level 0's. */
+ * (scene/run.c cut_parts()), else this thread runs it, before or after the rest (outside a
+ * team at once). The same bits either way; an error is the coarser levels' before level 0's. */
 static fcm_status create_beside(fcm_mg *m, mg_carry *carry, unsigned char *same)
 {
   fcm_status st = FCM_OK;

@@ -683,9 +683,11 @@ cleanup:
 }
 
 /* The setup's second stage, the values: the scheme, Nitsche's boundary, the mass matrix and
- * the loads, the representative force, the linear solver, the state and contact. It leaves
- * what setup_begin() wrote and the hierarchy's fields (I->mg, mg_A, mg_con, mg_creations)
- * as they are. */
+ * the loads, the representative force, the linear solver, the corotated element matrices
+ * not built yet (in the store of the assembly workspace setup_begin() made), the state and
+ * contact. It leaves the rest of what setup_begin() wrote and the hierarchy's fields (I->mg,
+ * mg_A, mg_con, mg_creations) as they are; the solver's structure reads neither the
+ * workspace nor its store. */
 static fcm_status setup_values(fcm_integrator *I)
 {
   fcm_status st = FCM_OK;
