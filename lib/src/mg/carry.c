@@ -49,25 +49,40 @@ static int carry_possible(const fcm_mg *m, const mg_carry *c)
   return pieces > 0 && pieces == fcm_cell_rules_num_pieces(from->rules);
 }
 
-int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple)
+/* m's space when level 0 is on its pattern, a full space with its copy graph; else NULL. */
+static const fcm_space *level0_graph(const fcm_mg *m)
 {
   const fcm_space *sp = m->pattern_of;
-  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
-      m->lev[0].n != 3 * sp->num_local_copies)
-    return 0;
+  return sp && sp == m->space && !sp->local_copy && sp->node_ptr && sp->node_adj &&
+                 m->lev[0].n == 3 * sp->num_local_copies
+             ? sp
+             : NULL;
+}
+
+/* The first place in copy k's graph row whose copy is not below k (k's own, if it is there). */
+static fcm_index own_slot(const fcm_space *sp, fcm_index k)
+{
+  fcm_index lo = sp->node_ptr[k], hi = sp->node_ptr[k + 1];
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (sp->node_adj[mid] < k)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple)
+{
+  const fcm_space *sp = level0_graph(m);
+  if (!sp) return 0;
   const fcm_index nk = sp->num_local_copies;
   int ok = 1;
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
     if (nk > 4096)
   for (fcm_index k = 0; k < nk; k++) { /* the row holds its own copy: the diagonal's node */
-    fcm_index lo = sp->node_ptr[k], hi = sp->node_ptr[k + 1];
-    while (lo < hi) {
-      const fcm_index mid = lo + (hi - lo) / 2;
-      if (sp->node_adj[mid] < k)
-        lo = mid + 1;
-      else
-        hi = mid;
-    }
+    const fcm_index lo = own_slot(sp, k);
     const int own = lo < sp->node_ptr[k + 1] && sp->node_adj[lo] == k;
     ok = ok && own;
     triple[3 * k] = (unsigned char)(own ? FCM__MG_TRIPLE_NODES : 0);
@@ -78,23 +93,14 @@ int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple)
 
 int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag)
 {
-  const fcm_space *sp = m->pattern_of;
-  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
-      m->lev[0].n != 3 * sp->num_local_copies)
-    return 0;
+  const fcm_space *sp = level0_graph(m);
+  if (!sp) return 0;
   const fcm_index nk = sp->num_local_copies, *rp = sp->row_ptr;
   int ok = 1;
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
     if (nk > 4096)
   for (fcm_index k = 0; k < nk; k++) {
-    fcm_index lo = sp->node_ptr[k], hi = sp->node_ptr[k + 1];
-    while (lo < hi) {
-      const fcm_index mid = lo + (hi - lo) / 2;
-      if (sp->node_adj[mid] < k)
-        lo = mid + 1;
-      else
-        hi = mid;
-    }
+    const fcm_index lo = own_slot(sp, k);
     /* the row's columns are the graph row's copies' three each (the space's pattern), so
      * its length and k's place in the graph row tell where column i lies (the columns are
      * not read: a cache miss a row) */
@@ -112,10 +118,8 @@ int fcm__mg_space_diag(const fcm_mg *m, fcm_index *diag)
 
 int fcm__mg_space_reach(const fcm_mg *m, fcm_index *reach)
 {
-  const fcm_space *sp = m->pattern_of;
-  if (!sp || sp != m->space || sp->local_copy || !sp->node_ptr || !sp->node_adj ||
-      m->lev[0].n != 3 * sp->num_local_copies)
-    return 0;
+  const fcm_space *sp = level0_graph(m);
+  if (!sp) return 0;
   const fcm_index nk = sp->num_local_copies, *rp = sp->row_ptr;
   int ok = 1;
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) reduction(&& : ok) \
