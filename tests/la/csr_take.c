@@ -2,11 +2,19 @@
  * when it fits: a large array (8 MiB or more) has a quarter more room than asked, so a matrix
  * up to that size, and at least half of it, lands on the same storage, zero filled again, and
  * the giver is left without values; a larger or a much smaller matrix gets storage of its own
- * and the giver keeps its values. The context counts one allocation per array throughout. */
+ * and the giver keeps its values. The context counts one allocation per array throughout. A
+ * matrix made on no giver's storage has its room mapped at once (the next cut's matrix grows
+ * into it without page faults): its last page is resident before anything writes it. */
+#define _DEFAULT_SOURCE /* mincore */
 #include "la/la_impl.h"
 #include "test.h"
 
+#include <stdint.h>
 #include <stdlib.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
 
 enum { NBIG = 1100000 }; /* 8.8 MB of values: room for 1,375,000 */
 
@@ -44,6 +52,23 @@ static void check_values(fcm_csr *A, fcm_index n)
   free(y);
 }
 
+/* 1 when the page holding the last byte of the room of n values at v (a quarter more than n
+ * from FCM__LARGE_MIN on) is resident; 1 where residency cannot be asked. */
+static int room_resident(const double *v, size_t n)
+{
+#if defined(__linux__)
+  const size_t bytes = n * sizeof *v, room = bytes >= FCM__LARGE_MIN ? bytes + bytes / 4 : bytes;
+  const uintptr_t page = (uintptr_t)sysconf(_SC_PAGESIZE);
+  const uintptr_t last = ((uintptr_t)v + room - 1) / page * page;
+  unsigned char in = 0;
+  if (mincore((void *)last, (size_t)page, &in) != 0) return 1;
+  return in & 1;
+#else
+  (void)v, (void)n;
+  return 1;
+#endif
+}
+
 int main(void)
 {
   const fcm_index nmax = 2 * NBIG;
@@ -58,6 +83,7 @@ int main(void)
 
   /* 10 % larger: taken, zero again, the giver without values */
   fcm_csr *A = diagonal(NBIG, NULL);
+  TEST_TRUE(room_resident(fcm_csr_values_read(A), NBIG));
   check_values(A, NBIG);
   const double *va = fcm_csr_values_read(A);
   const fcm_index n1 = NBIG + NBIG / 10;

@@ -24,8 +24,9 @@ void fcm__assembly_corot_free(fcm_assembly_workspace *ws)
 
 /* A new store, each element at its own slot, with a quarter more slots for the elements of
  * later cuts (fcm__assembly_corot_take()). A slot is read only once its element's matrix is
- * built there (have), so the arrays are not zero filled: the slots no element uses are
- * address space only. */
+ * built there (have); the arrays are zero filled all the same, so that the free slots are
+ * mapped now (resident: a quarter more than the elements'), not when a cut's new elements
+ * first write them (the first touch of fresh pages, slow on some virtual machines). */
 static fcm_status store_alloc(fcm_assembly_workspace *ws)
 {
   fcm_status st = FCM_OK;
@@ -34,8 +35,8 @@ static fcm_status store_alloc(fcm_assembly_workspace *ws)
   const fcm_index ne = s->num_elems;
   c->cb = 9 * (size_t)s->nn * (size_t)(s->nn + 1) / 2;
   c->cap = ne + ne / 4 + 1;
-  FCM__ALLOC_WITH(fcm__malloc_large, ws->ctx, (size_t)c->cap * c->cb, c->K);
-  FCM__ALLOC_WITH(fcm__malloc_large, ws->ctx, (size_t)c->cap * 3 * s->nn, c->G);
+  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)c->cap * c->cb, c->K);
+  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)c->cap * 3 * s->nn, c->G);
   FCM_ALLOC(ws->ctx, (size_t)ne + 1, c->have);
   FCM_ALLOC_RAW(ws->ctx, (size_t)ne + 1, c->slot);
   for (fcm_index e = 0; e < ne; e++)
