@@ -484,8 +484,8 @@ cleanup:
   return st;
 }
 
-/* Each region cell's links (cell_links()), in parallel: the cells' lists, in cell order, in
- * *links (*nl of them). The set does not depend on the threads; the caller sorts it. */
+/* Each region cell's links (cell_links()), in parallel: the cells' lists, each sorted, in cell
+ * order, in *links (*nl of them): sorted, and the same on any number of threads. */
 static fcm_status region_links(const build *B, const fcm_cell_rules *R, const cell_out *out,
                                fcm_index **links, size_t *nl, size_t *cap)
 {
@@ -513,6 +513,8 @@ static fcm_status region_links(const build *B, const fcm_cell_rules *R, const ce
       made = s == FCM_OK;
       size_t ccap = 0;
       if (s == FCM_OK) s = cell_links(B, R, out, c, mat, &tc, cl + c, cn + c, &ccap);
+      /* sorted here: each link starts at a piece of c, so the lists in cell order are sorted */
+      if (s == FCM_OK && cn[c] > 1) qsort(cl[c], cn[c], 2 * sizeof *cl[c], cmp_link);
       fcm__loop_leave(&loop, &it, s);
     }
     fcm__geom_idbuf_free(ctx, &tc);
@@ -607,8 +609,9 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
   FCM_TRY(ctx, region_links(B, R, out, &links, &nl, &cap));
   if (B->geom->num_cells == 0 && fcm_mesh_num_hanging(B->mesh) > 0)
     FCM_TRY(ctx, fcm__material_create(ctx, B->geom, &mat));
+  const size_t sorted = nl; /* region_links() gives them sorted */
   FCM_TRY(ctx, nc_links(B, R, out, mat, &tc, &links, &nl, &cap));
-  if (nl) qsort(links, nl, 2 * sizeof *links, cmp_link);
+  if (nl > sorted) qsort(links, nl, 2 * sizeof *links, cmp_link);
   R->links = links;
   R->num_links = (fcm_index)nl;
   links = NULL;
