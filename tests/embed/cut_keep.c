@@ -180,6 +180,42 @@ static void check_reference(const fcm_cell_rules *r, const fcm_cell_rules *ref,
   TEST_TRUE(kept <= fcm_cell_rules_get_stats(r)->num_kept);
 }
 
+/* A cell the cuts do not reach (r->reached) is one whose box of the reach test (its corners'
+ * box widened by the clip tolerance, then by twice the match tolerance of its size) meets no
+ * cut triangle's box, and the face polygons the rules keep of such cells lie in that box with
+ * the match tolerance around them: the links' queries of those polygons find no triangle
+ * without being made. Returns the unreached cells with kept face polygons. */
+static fcm_index check_unreached(const fcm_mesh *mesh, const fcm_cell_rules *r, double clip_rtol)
+{
+  fcm_index polys = 0;
+  for (fcm_index c = 0; c < r->num_cells; c++) {
+    if (r->reached[c]) continue;
+    fcm__embed_cell cell;
+    fcm__embed_cell_box(mesh, c, clip_rtol, &cell);
+    const double w = 2.0 * FCM__EMBED_MATCH_RTOL * cell.size, m = w / 2.0;
+    for (fcm_index t = 0; t < r->num_cut_tris; t++) {
+      int meets = 1;
+      for (int d = 0; d < 3; d++)
+        meets = meets && r->cut_tris[t].lo[d] <= cell.hi[d] + w &&
+                r->cut_tris[t].hi[d] >= cell.lo[d] - w;
+      TEST_TRUE(!meets);
+    }
+    if (!r->face_nfp || r->face_nfp[c] <= 0) continue;
+    size_t x = 0;
+    for (int i = 0; i < r->face_nfp[c]; i++) {
+      const int *meta = r->face_meta[c] + FCM__EMBED_FMETA * i;
+      for (int k = 0; k < meta[2]; k++)
+        for (int d = 0; d < 3; d++) {
+          const double v = r->face_x[c][3 * (x + (size_t)k) + d];
+          TEST_TRUE(v - m >= cell.lo[d] - w && v + m <= cell.hi[d] + w);
+        }
+      x += (size_t)(meta[2] + meta[3]);
+    }
+    polys++;
+  }
+  return polys;
+}
+
 int main(int argc, char **argv)
 {
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
@@ -193,6 +229,7 @@ int main(int argc, char **argv)
   fcm_mesh *mesh = NULL;
   fcm_geometry *g = NULL;
   fcm_cell_rules *r = NULL;
+  fcm_index unreached = 0; /* unreached cells with kept face polygons, over the cuts */
   TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
   TEST_OK(ctx, fcm_geometry_create_box(ctx, body_lo, body_hi, nb, &g));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r));
@@ -217,6 +254,7 @@ int main(int argc, char **argv)
              (long long)st->num_material_pieces, (long long)st->num_links);
     check_exact(mesh, next, cuts, j + 1);
     check_reference(next, ref, r);
+    unreached += check_unreached(mesh, next, o.clip_rtol);
     if (j < 2) TEST_TRUE(st->num_split > 0 && st->num_integrated > 0);
     if (j >= 2) { /* beside the body, along a grid plane: nothing changes */
       TEST_TRUE(st->num_integrated == 0 && st->num_kept > 0);
@@ -241,6 +279,7 @@ int main(int argc, char **argv)
     fcm_cell_rules_destroy(&r);
     r = next;
   }
+  TEST_TRUE(unreached > 0);
   fcm_cell_rules_destroy(&r);
   fcm_geometry_destroy(&g);
   fcm_mesh_destroy(&mesh);

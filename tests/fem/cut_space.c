@@ -58,6 +58,46 @@ static int same_space(const fcm_space *a, const fcm_space *b)
   return ok && !a->local_elem && !b->local_elem && !a->elem_lcopy && !b->elem_lcopy;
 }
 
+/* The elements the cut left (fcm__space_cut_same_elements()) with the pieces the cut copied
+ * taken as such (fcm__cell_rules_piece_copied()) are those found by comparing every piece's
+ * bits; every copied piece holds its parent's bits, some do, and none is copied from rules its
+ * rules do not extend. Returns the elements the cut left. */
+static fcm_index check_same_elements(const fcm_space *from, const fcm_space *to)
+{
+  fcm_cell_rules *r = (fcm_cell_rules *)to->rules;
+  const fcm_index ne = to->num_elems;
+  fcm_index *fast = malloc(sizeof *fast * (size_t)ne + 1),
+            *slow = malloc(sizeof *slow * (size_t)ne + 1);
+  fcm_index nfast = -1, nslow = -2, copied = 0;
+  TEST_OK(ctx, fcm__space_cut_same_elements(from, to, fast, &nfast));
+  unsigned char *flags = r->piece_copied;
+  r->piece_copied = NULL; /* compared bit for bit */
+  TEST_OK(ctx, fcm__space_cut_same_elements(from, to, slow, &nslow));
+  r->piece_copied = flags;
+  TEST_TRUE(nfast == nslow && same(fast, slow, (size_t)ne, sizeof *fast));
+  TEST_TRUE(flags != NULL);
+  for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(r); p++) {
+    TEST_TRUE(!fcm__cell_rules_piece_copied(r, p, r));
+    if (!fcm__cell_rules_piece_copied(r, p, from->rules)) continue;
+    const fcm_index q = fcm_cell_rules_piece_parent(r, p);
+    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+      int na = 0, nb = 0;
+      const double *xa = NULL, *xb = NULL, *wa = NULL, *wb = NULL;
+      const unsigned char *fa = NULL, *fb = NULL;
+      if (!fcm_cell_rules_has_kind(r, (fcm_rule_kind)k)) continue;
+      fcm_cell_rules_get_piece(r, p, (fcm_rule_kind)k, &na, &xa, &wa, &fa);
+      fcm_cell_rules_get_piece(from->rules, q, (fcm_rule_kind)k, &nb, &xb, &wb, &fb);
+      TEST_TRUE(na == nb && same(xa, xb, 3 * (size_t)na, sizeof *xa) &&
+                same(wa, wb, (size_t)na, sizeof *wa) && same(fa, fb, (size_t)na, 1));
+    }
+    copied += fcm_cell_rules_class(r, fcm_cell_rules_piece_cell(r, p)) == FCM_CELL_CUT;
+  }
+  TEST_TRUE(copied > 0 && nfast > 0 && nfast < ne);
+  free(fast);
+  free(slow);
+  return nfast;
+}
+
 /* The three cuts on the box, each space patched from the last; ratio: the constraint ratio.
  * Returns the constrained copies of the last space. */
 static fcm_index run(const fcm_mesh *mesh, const fcm_geometry *g, double ratio)
@@ -93,6 +133,7 @@ static fcm_index run(const fcm_mesh *mesh, const fcm_geometry *g, double ratio)
              (long long)rows);
       TEST_TRUE(space[k]->num_dofs > space[k - 1]->num_dofs);
       TEST_TRUE(same_space(space[k], fresh));
+      check_same_elements(space[k - 1], space[k]);
       /* the patch took rows away from the cut and made the cut's own anew */
       TEST_TRUE(space[k]->cut_kept_rows >= rows / 10 && space[k]->cut_kept_rows < rows);
       TEST_TRUE(fresh->cut_kept_rows == 0);

@@ -44,6 +44,7 @@ void fcm_cell_rules_destroy(fcm_cell_rules **rules)
   fcm__free(ctx, R->piece_volume);
   fcm__free(ctx, R->piece_parent);
   fcm__free(ctx, R->piece_component);
+  fcm__free(ctx, R->piece_copied);
   fcm__free(ctx, R->cut_tris);
   fcm__free(ctx, R->links);
   fcm__free(ctx, R->reached);

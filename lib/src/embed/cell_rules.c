@@ -269,6 +269,7 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
     }
     R->num_cuts = prev->num_cuts + 1;
     R->prev_num_pieces = prev->num_pieces;
+    R->parent_id = prev->id;
     /* rules built with a cell_mask: the same cells get points (the others are classified,
      * split and get their cut faces: the same pieces and DOF copies on every process) */
     R->opts.cell_mask = prev->own;

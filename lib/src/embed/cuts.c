@@ -353,6 +353,16 @@ cleanup:
   return st;
 }
 
+/* Whether the box lo..hi lies in the box of `cell` that reached_cells() queries
+ * (fcm__embed_cut_candidates()): a query of lo..hi then finds a subset of what that one finds. */
+static int within_reach_box(const fcm__embed_cell *cell, const double lo[3], const double hi[3])
+{
+  const double w = 2.0 * FCM__EMBED_MATCH_RTOL * cell->size;
+  for (int d = 0; d < 3; d++)
+    if (!(lo[d] >= cell->lo[d] - w && hi[d] <= cell->hi[d] + w)) return 0;
+  return 1;
+}
+
 /* The links across one face shared by cells c (its face f) and c2 (its face f2), `cell` set
  * up for c: a polygon of a piece of c on the face overlaps a polygon of a piece of c2 on its
  * face with positive area, the overlap does not lie on a cut triangle, their parents were
@@ -400,7 +410,10 @@ static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell
           for (int k = 0; k < ma[2]; k++)
             lo[d] = fmin(lo[d], A[3 * k + d] - mtol), hi[d] = fmax(hi[d], A[3 * k + d] + mtol);
         }
-        FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, tc));
+        if (R->reached[c] || !within_reach_box(cell, lo, hi))
+          FCM_TRY(ctx, fcm__geom_tree_query(ctx, B->cut_tree, lo, hi, tc));
+        else
+          tc->n = 0; /* no triangle meets the larger box of cell c (reached_cells()) */
         queried = 1;
       }
       if (!fcm__embed_linked(A, ma[2], A + 3 * ma[2], ma[3], Bx, mb[2], Bx + 3 * mb[2], mb[3], nbn,
@@ -471,8 +484,8 @@ cleanup:
   return st;
 }
 
-/* Each region cell's links (cell_links()), in parallel: the cells' lists, in cell order, in
- * *links (*nl of them). The set does not depend on the threads; the caller sorts it. */
+/* Each region cell's links (cell_links()), in parallel: the cells' lists, each sorted, in cell
+ * order, in *links (*nl of them): sorted, and the same on any number of threads. */
 static fcm_status region_links(const build *B, const fcm_cell_rules *R, const cell_out *out,
                                fcm_index **links, size_t *nl, size_t *cap)
 {
@@ -500,6 +513,8 @@ static fcm_status region_links(const build *B, const fcm_cell_rules *R, const ce
       made = s == FCM_OK;
       size_t ccap = 0;
       if (s == FCM_OK) s = cell_links(B, R, out, c, mat, &tc, cl + c, cn + c, &ccap);
+      /* sorted here: each link starts at a piece of c, so the lists in cell order are sorted */
+      if (s == FCM_OK && cn[c] > 1) qsort(cl[c], cn[c], 2 * sizeof *cl[c], cmp_link);
       fcm__loop_leave(&loop, &it, s);
     }
     fcm__geom_idbuf_free(ctx, &tc);
@@ -594,8 +609,9 @@ fcm_status fcm__embed_gather_links(const build *B, fcm_cell_rules *R, const cell
   FCM_TRY(ctx, region_links(B, R, out, &links, &nl, &cap));
   if (B->geom->num_cells == 0 && fcm_mesh_num_hanging(B->mesh) > 0)
     FCM_TRY(ctx, fcm__material_create(ctx, B->geom, &mat));
+  const size_t sorted = nl; /* region_links() gives them sorted */
   FCM_TRY(ctx, nc_links(B, R, out, mat, &tc, &links, &nl, &cap));
-  if (nl) qsort(links, nl, 2 * sizeof *links, cmp_link);
+  if (nl > sorted) qsort(links, nl, 2 * sizeof *links, cmp_link);
   R->links = links;
   R->num_links = (fcm_index)nl;
   links = NULL;

@@ -100,6 +100,12 @@ struct fcm_cell_rules {
   fcm_index *piece_parent;
   fcm_index prev_num_pieces;
   int *piece_component;
+  /* id: this object's number, unique in the process; parent_id: the number of the rules a cut
+   * extended into it (0 for fcm_cell_rules_create()). piece_copied[p] (NULL without a parent):
+   * piece p's volume and surface rules are its parent piece's, copied bits (a cell the cut
+   * does not reach, or one whose pieces it leaves whole): fcm__cell_rules_piece_copied() */
+  unsigned long long id, parent_id;
+  unsigned char *piece_copied;
   fcm_cell_rules_stats stats;
 };
 
@@ -535,6 +541,15 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
 static inline int fcm__cell_rules_owns(const fcm_cell_rules *R, fcm_index cell)
 {
   return !R || !R->own || R->own[cell];
+}
+
+/* 1 when piece p of R holds the bits of the volume and surface rules (points, weights, flags of
+ * every kind and the surface points, weights, normals) of its parent piece in `from`, the rules
+ * R extends: R copied them (its cut faces may be new); 0 when not known. */
+static inline int fcm__cell_rules_piece_copied(const fcm_cell_rules *R, fcm_index p,
+                                               const fcm_cell_rules *from)
+{
+  return R && from && R->piece_copied && R->parent_id == from->id && R->piece_copied[p];
 }
 
 /* A sum over the processes of a distributed run (the PETSc backend's reduce): agree on st

@@ -5,6 +5,7 @@
 #include "simplify/simplify_impl.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -103,6 +104,9 @@ static void kind_space(const fcm_element_info *info, const fcm_cell_rules_option
   *axis = FCM_MIN(*axis, *strength);
 }
 
+/* The rules objects' numbers (fcm_cell_rules.id), from 1. */
+static atomic_ullong rules_ids = 1;
+
 /* Phase 1a: the result object with its per-cell arrays, strengths and catalogue rules. */
 fcm_status fcm__embed_rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh,
                                   const fcm_cell_rules_options *o, fcm_cell_rules **out)
@@ -113,6 +117,7 @@ fcm_status fcm__embed_rules_alloc(fcm_ctx *ctx, const fcm_mesh *mesh,
   const fcm_index nc = fcm_mesh_num_cells(mesh);
   FCM_ALLOC(ctx, 1, R);
   R->ctx = ctx;
+  R->id = atomic_fetch_add(&rules_ids, 1);
   R->num_cells = nc;
   R->type = info->type;
   R->surface_strength = o->surface_strength;
@@ -294,6 +299,9 @@ fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_o
   FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->cfoff);
   for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
     FCM_ALLOC_RAW(ctx, (size_t)np + 1, R->off[k]);
+  fcm__free(ctx, R->piece_copied);
+  R->piece_copied = NULL;
+  if (prev) FCM_ALLOC(ctx, (size_t)np + 1, R->piece_copied);
   /* every piece's entries of the arrays above in one pass over the cells (the slot past the
    * last piece of the first four is never read: zeroed as before) */
   R->piece_cell[np] = 0, R->piece_volume[np] = 0.0, R->piece_parent[np] = 0;
@@ -311,6 +319,7 @@ fcm_status fcm__embed_gather_rules(fcm_ctx *ctx, fcm_cell_rules *R, const cell_o
       R->piece_volume[p] = q->volume;
       R->piece_parent[p] = prev ? prev->piece_off[c] + q->parent : -1;
       R->piece_component[p] = q->component;
+      if (R->piece_copied) R->piece_copied[p] = q->copied;
       for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)
         R->off[k][p + 1] = R->off[k][p] + (cut ? q->n[k] : 0);
       R->cfoff[p + 1] = R->cfoff[p] + q->ncf;

@@ -128,8 +128,12 @@ fcm_status fcm__space_cut_same_elements(const fcm_space *from, const fcm_space *
     same[e] = -1;
     if (ct != cf || fe < 0) continue;
     /* an uncut cell integrates with the standard rule in both; a cut one with its piece's */
+    /* a piece the cut copied from its parent has its parent's bits (no need to compare) */
+    const fcm_index p = to->elem_piece[e], q = from->elem_piece[fe];
     if (ct == FCM_CELL_UNCUT ||
-        same_piece(to->rules, to->elem_piece[e], from->rules, from->elem_piece[fe])) {
+        (fcm__cell_rules_piece_copied(to->rules, p, from->rules) &&
+         fcm_cell_rules_piece_parent(to->rules, p) == q) ||
+        same_piece(to->rules, p, from->rules, q)) {
       same[e] = fe;
       count++;
     }
