@@ -302,15 +302,26 @@ cleanup:
   return st;
 }
 
-/* Clip the pairs of cell c from *k on (the finder holds c's parts). */
-static fcm_status preclip_cell(fcm_embedded_surface *es, fcm_index c, preclip *pc, size_t *k)
+/* Clip the pairs of cell c from *k on (the finder holds c's parts), but those of triangles
+ * known by now to stay whole: no cut crosses them (crosses) and each vertex is either known
+ * off the cuts (on_cut, once looked up: a vertex in a cell up to c, or one whose answer is
+ * kept; `lookup` flags the vertices looked up in this rebuild) or not near one (maybe). What
+ * is left out here and split after all is clipped by split_triangles(). */
+static fcm_status preclip_cell(fcm_embedded_surface *es, fcm_index c, const unsigned char *crosses,
+                               const unsigned char *maybe, const unsigned char *on_cut,
+                               const unsigned char *lookup, preclip *pc, size_t *k)
 {
   fcm_status st = FCM_OK;
   for (; *k < pc->n && pc->pairs[2 * *k] <= c; ++*k) {
     pc->off[*k] = pc->polys.n, pc->xoff[*k] = pc->polys.nx;
     if (pc->pairs[2 * *k] < c) continue;
+    const fcm_index t = pc->pairs[2 * *k + 1], *v = es->tri0 + 3 * t;
+    int may = crosses[t];
+    for (int a = 0; a < 3 && !may; a++)
+      may = lookup[v[a]] && es->cell[v[a]] > c ? maybe[v[a]] : on_cut[v[a]];
+    if (!may) continue;
     double x[9];
-    tri_coords(es, pc->pairs[2 * *k + 1], x);
+    tri_coords(es, t, x);
     FCM_TRY(es->ctx, fcm__embed_finder_clip(es->finder, c, x, &pc->polys));
   }
 cleanup:
@@ -378,9 +389,11 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
   const fcm_space *s = es->space;
   fcm__embed_finder *f = es->finder;
   fcm_index *pairs = NULL, *vpiece = NULL, n = 0;
-  unsigned char *on_cut = NULL, *maybe = NULL, *qcell = NULL;
+  unsigned char *on_cut = NULL, *maybe = NULL, *qcell = NULL, *lookup = NULL;
   FCM_ALLOC(ctx, (size_t)es->nb + 1, on_cut);
   FCM_ALLOC(ctx, (size_t)es->nb + 1, maybe);
+  FCM_ALLOC(ctx, (size_t)es->nb + 1, lookup);
+  FCM_TRY(ctx, cell_tree(es)); /* cell_pad */
   FCM_ALLOC(ctx, (size_t)fcm_mesh_num_cells(es->mesh) + 1, qcell);
   FCM_ALLOC_RAW(ctx, 2 * (size_t)es->nb + 2, pairs);
   FCM_ALLOC_RAW(ctx, (size_t)es->nb + 1, vpiece);
@@ -396,7 +409,10 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
       continue;
     }
     pairs[2 * n] = c, pairs[2 * n + 1] = i, n++;
-    maybe[i] = qcell[c] = 1;
+    int near = 0; /* a vertex on a cut lies on a cut triangle: the pad is far above its tolerance */
+    FCM_TRY(ctx, fcm__embed_finder_near_cut(f, es->X + 3 * i, es->cell_pad, &near));
+    maybe[i] = (unsigned char)near;
+    lookup[i] = qcell[c] = 1;
   }
   FCM_TRY(ctx, cut_crossings(es, extends, split)); /* the cuts' triangles alone decide */
   FCM_TRY(ctx, preclip_pairs(es, split, maybe, qcell, pc));
@@ -410,9 +426,11 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
     if (e >= 0) es->elem[i] = e;
     on_cut[i] = p == -2;
     vpiece[i] = p;
-    if (k + 1 == n || pairs[2 * (k + 1)] != c) FCM_TRY(ctx, preclip_cell(es, c, pc, &kc));
+    if (k + 1 == n || pairs[2 * (k + 1)] != c)
+      FCM_TRY(ctx, preclip_cell(es, c, split, maybe, on_cut, lookup, pc, &kc));
   }
-  FCM_TRY(ctx, preclip_cell(es, fcm_mesh_num_cells(es->mesh), pc, &kc));
+  FCM_TRY(ctx,
+          preclip_cell(es, fcm_mesh_num_cells(es->mesh), split, maybe, on_cut, lookup, pc, &kc));
   pc->off[pc->n] = pc->polys.n, pc->xoff[pc->n] = pc->polys.nx;
   fcm__free(ctx, es->vpiece);
   es->vpiece = vpiece;
@@ -426,6 +444,7 @@ cleanup:
   fcm__free(ctx, vpiece);
   fcm__free(ctx, on_cut);
   fcm__free(ctx, maybe);
+  fcm__free(ctx, lookup);
   fcm__free(ctx, qcell);
   return st;
 }
@@ -737,9 +756,10 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   es->num_split = nsplit;
 cleanup:
   if (st != FCM_OK) cache_clear(es);
-  /* the finder holds the cut cells' parts and the search trees: made per call (per cut); the
-   * cells' tree is the mesh's, which a new space keeps (fcm_embedded_surface_set_space()) */
-  fcm__embed_finder_destroy(&es->finder);
+  /* the finder's parts and cut triangles' tree are the rules': freed per call (per cut); what
+   * it holds for the mesh and geometry stays, as does the cells' tree (the mesh's, which a new
+   * space keeps: fcm_embedded_surface_set_space()) */
+  fcm__embed_finder_release(es->finder);
   fcm__free(ctx, split);
   fcm__free(ctx, changed);
   fcm__free(ctx, src);
