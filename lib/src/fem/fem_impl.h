@@ -598,6 +598,10 @@ struct fcm_embedded_surface {
   unsigned char *cross;        /* nbt: whether a cut triangle of those rules crosses triangle t */
   size_t npairs, *poff, *xoff; /* xoff: pair k's first polygon vertex */
   fcm__embed_polys polys;
+  /* 3 per vertex of polys: its reference coordinates in its pair's cell for elements of
+   * pxi_type (NaN: not mapped) */
+  double *pxi;
+  fcm_element_type pxi_type;
 };
 
 /* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite

@@ -140,13 +140,13 @@ cleanup:
 static void cache_clear(fcm_embedded_surface *es)
 {
   void *arrays[] = {es->prev_tris, es->prev_piece_off, es->vpiece, es->pairs,
-                    es->poff,      es->xoff,           es->cross};
+                    es->poff,      es->xoff,           es->cross,  es->pxi};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(es->ctx, arrays[k]);
   fcm__embed_polys_free(es->ctx, &es->polys);
   es->prev_tris = NULL, es->prev_piece_off = es->vpiece = es->pairs = NULL;
   es->poff = es->xoff = NULL;
-  es->cross = NULL;
+  es->cross = NULL, es->pxi = NULL;
   es->prev_ntris = es->prev_ncells = 0;
   es->npairs = 0;
 }
@@ -173,9 +173,11 @@ cleanup:
 }
 
 /* Keep the clipped parts of the (cell, triangle) pairs (*pairs, n, sorted) for the next
- * rebuild: the arrays are taken, the polygons copied. */
+ * rebuild, with their vertices' reference coordinates (*pxi, 3 per vertex of polys; NaN: not
+ * mapped yet): the arrays are taken, the polygons copied. */
 static fcm_status cache_parts(fcm_embedded_surface *es, const fcm__embed_polys *polys,
-                              fcm_index **pairs, size_t n, size_t **poff, size_t **xoff)
+                              fcm_index **pairs, size_t n, size_t **poff, size_t **xoff,
+                              double **pxi)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
@@ -194,8 +196,10 @@ static fcm_status cache_parts(fcm_embedded_surface *es, const fcm__embed_polys *
   fcm__free(ctx, es->pairs);
   fcm__free(ctx, es->poff);
   fcm__free(ctx, es->xoff);
+  fcm__free(ctx, es->pxi);
   es->pairs = *pairs, es->poff = *poff, es->xoff = *xoff, es->npairs = n;
-  *pairs = NULL, *poff = NULL, *xoff = NULL;
+  es->pxi = *pxi;
+  *pairs = NULL, *poff = NULL, *xoff = NULL, *pxi = NULL;
 cleanup:
   fcm__embed_polys_free(ctx, &copy);
   return st;
@@ -460,8 +464,8 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
   fcm_ctx *ctx = es->ctx;
   fcm_index *pairs = NULL, *ps = NULL, *pc = NULL;
   size_t *poff = NULL, *xoff = NULL;
-  double *area = NULL;
-  size_t n = 0, cap = 0, pcap = 0;
+  double *area = NULL, *pxi = NULL;
+  size_t n = 0, cap = 0, pcap = 0, xcap = 0;
   fcm__idbuf ids = {NULL, 0, 0};
   FCM_TRY(ctx, cell_tree(es));
   for (fcm_index t = 0; t < es->nbt; t++) {
@@ -490,7 +494,8 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
       j++;
     while (jp < pre->n && cmp_pair(pre->pairs + 2 * jp, pairs + 2 * k) < 0)
       jp++;
-    if (!changed[c] && j < es->npairs && !cmp_pair(es->pairs + 2 * j, pairs + 2 * k)) {
+    const int reused = !changed[c] && j < es->npairs && !cmp_pair(es->pairs + 2 * j, pairs + 2 * k);
+    if (reused) {
       size_t first_x = es->xoff[j]; /* the parts the last rebuild clipped */
       for (size_t q = es->poff[j]; q < es->poff[j + 1]; first_x += (size_t)es->polys.nv[q++])
         FCM_TRY(ctx, polys_append(ctx, polys, &es->polys, q, first_x,
@@ -504,6 +509,18 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
       tri_coords(es, t, x);
       FCM_TRY(ctx, fcm__embed_finder_clip(es->finder, c, x, polys));
     }
+    if (polys->nx > xcap) {
+      const size_t ncap = FCM_MAX(2 * xcap, polys->nx + 1024);
+      void *a = pxi;
+      FCM_TRY(ctx, fcm__resize(ctx, &a, 3 * xcap, 3 * ncap, sizeof(double)));
+      pxi = a;
+      xcap = ncap;
+    }
+    if (reused && es->pxi)
+      memcpy(pxi + 3 * xoff[k], es->pxi + 3 * es->xoff[j], 3 * (polys->nx - xoff[k]) * sizeof *pxi);
+    else
+      for (size_t q = 3 * xoff[k]; q < 3 * polys->nx; q++)
+        pxi[q] = NAN;
     if (polys->n > pcap) {
       const size_t ncap = FCM_MAX(2 * pcap, polys->n + 256);
       void *a = ps, *b = pc;
@@ -517,7 +534,8 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
       ps[q] = t, pc[q] = c;
   }
   poff[n] = polys->n, xoff[n] = polys->nx;
-  FCM_TRY(ctx, cache_parts(es, polys, &pairs, n, &poff, &xoff));
+  if (!pxi) FCM_ALLOC_RAW(ctx, 3, pxi);
+  FCM_TRY(ctx, cache_parts(es, polys, &pairs, n, &poff, &xoff, &pxi));
   /* the parts cover each triangle: else it stays whole */
   FCM_ALLOC(ctx, (size_t)es->nbt + 1, area);
   for (size_t j = 0, off = 0; j < polys->n; off += (size_t)polys->nv[j], j++) {
@@ -541,6 +559,7 @@ cleanup:
   fcm__free(ctx, ps);
   fcm__free(ctx, pc);
   fcm__free(ctx, area);
+  fcm__free(ctx, pxi);
   fcm__geom_idbuf_free(ctx, &ids);
   return st;
 }
@@ -606,9 +625,10 @@ cleanup:
 /* Points [v, v + n) of the split triangles' parts: reference coordinates in their cells and
  * elements. A part no piece holds (in a dropped cell or piece) follows the element
  * fcm_space_point_element() picks, in the cell fcm_space_locate() finds when its own has no
- * element. */
+ * element. Point i is vertex xat[i - v] of es->polys: its reference coordinates in its cell
+ * are taken from es->pxi where mapped, else mapped and kept there. */
 static fcm_status part_points(fcm_embedded_surface *es, fcm_index v, fcm_index n,
-                              const fcm_index *piece)
+                              const fcm_index *piece, const size_t *xat)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
@@ -617,11 +637,22 @@ static fcm_status part_points(fcm_embedded_surface *es, fcm_index v, fcm_index n
   fcm_index last = -1, *lost = NULL, nlost = 0;
   double *lx = NULL, *lxi = NULL;
   fcm_index *lc = NULL;
+  if (es->pxi && es->pxi_type != s->type) { /* mapped for other elements */
+    for (size_t k = 0; k < 3 * es->polys.nx; k++)
+      es->pxi[k] = NAN;
+    es->pxi_type = s->type;
+  }
   for (fcm_index i = v; i < v + n; i++) {
     const fcm_index c = es->cell[i];
-    if (c != last) fcm_mesh_cell_coords(es->mesh, c, X);
-    last = c;
-    FCM_TRY(ctx, fcm_element_inverse_map(ctx, s->type, X, es->X + 3 * i, es->xi + 3 * i));
+    double *kept = es->pxi ? es->pxi + 3 * xat[i - v] : NULL;
+    if (kept && !isnan(kept[0])) {
+      memcpy(es->xi + 3 * i, kept, 3 * sizeof *kept);
+    } else {
+      if (c != last) fcm_mesh_cell_coords(es->mesh, c, X);
+      last = c;
+      FCM_TRY(ctx, fcm_element_inverse_map(ctx, s->type, X, es->X + 3 * i, es->xi + 3 * i));
+      if (kept) memcpy(kept, es->xi + 3 * i, 3 * sizeof *kept);
+    }
     es->elem[i] = piece_element(s, c, piece[i - v]);
     if (es->elem[i] < 0) es->elem[i] = fcm_space_point_element(s, c, es->xi + 3 * i);
     if (es->elem[i] < 0) {
@@ -665,7 +696,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   preclip pre;
   fcm_index *src = NULL, *pcell = NULL, *order = NULL, *ppiece = NULL, *by_tri = NULL;
   memset(&pre, 0, sizeof pre);
-  size_t *first_x = NULL;
+  size_t *first_x = NULL, *xat = NULL;
   fcm_index ncf = 0;
   for (fcm_index p = 0; p < npieces; p++)
     ncf += fcm_cell_rules_get_piece_cut_faces(rules, p, NULL);
@@ -716,6 +747,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   for (fcm_index k = 0; k < es->nbt; k++)
     if (!split[k]) memcpy(es->tri + 3 * t++, es->tri0 + 3 * k, 3 * sizeof *es->tri);
   FCM_ALLOC(ctx, (size_t)nsv + 1, ppiece);
+  FCM_ALLOC_RAW(ctx, (size_t)nsv + 1, xat);
   for (fcm_index k = 0; k < nkeep; k++) {
     const fcm_index j = order[k];
     const int m = polys.nv[j];
@@ -724,6 +756,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
       es->cell[v + a] = pcell[j];
       es->flag[v + a] = 0;
       ppiece[v + a - es->nb] = polys.piece[j];
+      xat[v + a - es->nb] = first_x[j] + (size_t)a;
     }
     for (int a = 1; a + 1 < m; a++, t++) { /* fan: the polygon keeps the triangle's orientation */
       es->tri[3 * t] = v;
@@ -732,7 +765,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
     }
     v += m;
   }
-  FCM_TRY(ctx, part_points(es, es->nb, nsv, ppiece));
+  FCM_TRY(ctx, part_points(es, es->nb, nsv, ppiece, xat));
   double Xc[3 * FCM_ELEMENT_MAX_NODES];
   for (fcm_index p = 0; p < npieces; p++) {
     const double *xi;
@@ -768,6 +801,7 @@ cleanup:
   fcm__free(ctx, by_tri);
   fcm__free(ctx, first_x);
   fcm__free(ctx, ppiece);
+  fcm__free(ctx, xat);
   fcm__embed_polys_free(ctx, &polys);
   preclip_free(ctx, &pre);
   return st;
