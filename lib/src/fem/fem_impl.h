@@ -602,6 +602,12 @@ struct fcm_embedded_surface {
    * pxi_type (NaN: not mapped) */
   double *pxi;
   fcm_element_type pxi_type;
+  /* The cells each boundary triangle's box meets (the geometry's and mesh's, fixed), found
+   * when first needed: triangle t's tc_n[t] cells from tc_ids[tc_first[t]] (tc_first[t] < 0:
+   * not yet; NULL: none found yet), tc_len of tc_cap used. */
+  fcm_index *tc_first, *tc_ids;
+  int *tc_n;
+  size_t tc_len, tc_cap;
 };
 
 /* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite

@@ -255,19 +255,51 @@ static void preclip_free(fcm_ctx *ctx, preclip *pc)
   memset(pc, 0, sizeof *pc);
 }
 
-/* The cells boundary triangle t touches within rounding, into ids. */
-static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, fcm__idbuf *ids)
+/* The cells boundary triangle t touches within rounding: *n of them from *ids (valid until the
+ * next call), found once a surface (es->tc_*: they depend on the geometry and mesh alone). */
+static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, const fcm_index **ids, size_t *n)
 {
-  double x[9], lo[3], hi[3], w = 0.0;
-  tri_coords(es, t, x);
-  for (int d = 0; d < 3; d++) {
-    lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d]));
-    hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d]));
-    w = fmax(w, hi[d] - lo[d]);
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  fcm__idbuf q = {NULL, 0, 0};
+  if (!es->tc_first) {
+    fcm_index *first = NULL;
+    FCM_ALLOC_RAW(ctx, (size_t)es->nbt + 1, es->tc_n);
+    FCM_ALLOC_RAW(ctx, (size_t)es->nbt + 1, first);
+    for (fcm_index k = 0; k < es->nbt; k++)
+      first[k] = -1;
+    es->tc_first = first;
   }
-  for (int d = 0; d < 3; d++)
-    lo[d] -= 1e-9 * w, hi[d] += 1e-9 * w;
-  return fcm__geom_tree_query(es->ctx, es->cell_tree, lo, hi, ids);
+  if (es->tc_first[t] < 0) {
+    double x[9], lo[3], hi[3], w = 0.0;
+    tri_coords(es, t, x);
+    for (int d = 0; d < 3; d++) {
+      lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d]));
+      hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d]));
+      w = fmax(w, hi[d] - lo[d]);
+    }
+    for (int d = 0; d < 3; d++)
+      lo[d] -= 1e-9 * w, hi[d] += 1e-9 * w;
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, es->cell_tree, lo, hi, &q));
+    if (es->tc_len + q.n > es->tc_cap) {
+      size_t cap = es->tc_cap ? 2 * es->tc_cap : 4096;
+      while (cap < es->tc_len + q.n)
+        cap *= 2;
+      void *a = es->tc_ids;
+      FCM_TRY(ctx, fcm__resize(ctx, &a, es->tc_len, cap, sizeof(fcm_index)));
+      es->tc_ids = a;
+      es->tc_cap = cap;
+    }
+    memcpy(es->tc_ids + es->tc_len, q.ids, q.n * sizeof *q.ids);
+    es->tc_first[t] = (fcm_index)es->tc_len;
+    es->tc_n[t] = (int)q.n;
+    es->tc_len += q.n;
+  }
+  *ids = es->tc_ids + es->tc_first[t];
+  *n = (size_t)es->tc_n[t];
+cleanup:
+  fcm__geom_idbuf_free(ctx, &q);
+  return st;
 }
 
 /* The (cell, triangle) pairs split_triangles() may clip in the cells the vertices' pieces load
@@ -278,15 +310,15 @@ static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *c
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
-  fcm__idbuf ids = {NULL, 0, 0};
   size_t cap = 0;
   FCM_TRY(ctx, cell_tree(es));
   for (fcm_index t = 0; t < es->nbt; t++) {
-    const fcm_index *v = es->tri0 + 3 * t;
+    const fcm_index *v = es->tri0 + 3 * t, *ids;
+    size_t nids;
     if (!crosses[t] && !maybe[v[0]] && !maybe[v[1]] && !maybe[v[2]]) continue;
-    FCM_TRY(ctx, tri_cells(es, t, &ids));
-    for (size_t k = 0; k < ids.n; k++) {
-      if (!qcell[ids.ids[k]]) continue;
+    FCM_TRY(ctx, tri_cells(es, t, &ids, &nids));
+    for (size_t k = 0; k < nids; k++) {
+      if (!qcell[ids[k]]) continue;
       if (pc->n == cap) {
         const size_t ncap = cap ? 2 * cap : 1024;
         void *q = pc->pairs;
@@ -294,7 +326,7 @@ static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *c
         pc->pairs = q;
         cap = ncap;
       }
-      pc->pairs[2 * pc->n] = ids.ids[k], pc->pairs[2 * pc->n + 1] = t;
+      pc->pairs[2 * pc->n] = ids[k], pc->pairs[2 * pc->n + 1] = t;
       pc->n++;
     }
   }
@@ -302,7 +334,6 @@ static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *c
   FCM_ALLOC_RAW(ctx, pc->n + 1, pc->off);
   FCM_ALLOC_RAW(ctx, pc->n + 1, pc->xoff);
 cleanup:
-  fcm__geom_idbuf_free(ctx, &ids);
   return st;
 }
 
@@ -407,7 +438,7 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
     if (s->cell_elem[c + 1] - s->cell_elem[c] <= 1) continue;
     if (es->vpiece && !changed[c] && es->vpiece[i] != -3) { /* as the last rebuild found */
       const fcm_index p = map_piece(es, c, es->vpiece[i]), e = piece_element(s, c, p);
-      if (e >= 0) es->elem[i] = e;
+      es->elem[i] = e >= 0 ? e : fcm_space_point_element(s, c, es->xi + 3 * i);
       on_cut[i] = maybe[i] = p == -2;
       vpiece[i] = p;
       continue;
@@ -427,7 +458,7 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
     fcm_index p = -1;
     FCM_TRY(ctx, fcm__embed_finder_point(f, c, es->X + 3 * i, &p));
     const fcm_index e = piece_element(s, c, p);
-    if (e >= 0) es->elem[i] = e;
+    es->elem[i] = e >= 0 ? e : fcm_space_point_element(s, c, es->xi + 3 * i);
     on_cut[i] = p == -2;
     vpiece[i] = p;
     if (k + 1 == n || pairs[2 * (k + 1)] != c)
@@ -466,22 +497,23 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
   size_t *poff = NULL, *xoff = NULL;
   double *area = NULL, *pxi = NULL;
   size_t n = 0, cap = 0, pcap = 0, xcap = 0;
-  fcm__idbuf ids = {NULL, 0, 0};
   FCM_TRY(ctx, cell_tree(es));
   for (fcm_index t = 0; t < es->nbt; t++) {
+    const fcm_index *ids;
+    size_t nids;
     if (!split[t]) continue;
-    FCM_TRY(ctx, tri_cells(es, t, &ids));
-    if (n + ids.n > cap) {
+    FCM_TRY(ctx, tri_cells(es, t, &ids, &nids));
+    if (n + nids > cap) {
       size_t ncap = cap ? 2 * cap : 1024;
-      while (ncap < n + ids.n)
+      while (ncap < n + nids)
         ncap *= 2;
       void *q = pairs;
       FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * n, 2 * ncap, sizeof(fcm_index)));
       pairs = q;
       cap = ncap;
     }
-    for (size_t k = 0; k < ids.n; k++, n++)
-      pairs[2 * n] = ids.ids[k], pairs[2 * n + 1] = t;
+    for (size_t k = 0; k < nids; k++, n++)
+      pairs[2 * n] = ids[k], pairs[2 * n + 1] = t;
   }
   qsort(pairs, n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
   FCM_ALLOC_RAW(ctx, n + 1, poff);
@@ -560,7 +592,6 @@ cleanup:
   fcm__free(ctx, pc);
   fcm__free(ctx, area);
   fcm__free(ctx, pxi);
-  fcm__geom_idbuf_free(ctx, &ids);
   return st;
 }
 
@@ -700,13 +731,17 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   fcm_index ncf = 0;
   for (fcm_index p = 0; p < npieces; p++)
     ncf += fcm_cell_rules_get_piece_cut_faces(rules, p, NULL);
+  const int cuts = rules && fcm_cell_rules_num_cuts(rules) > 0;
   for (fcm_index i = 0; i < es->nb; i++) {
-    es->elem[i] = fcm_space_point_element(s, es->cell[i], es->xi + 3 * i);
+    const fcm_index c = es->cell[i];
+    es->flag[i] = 0;
+    /* with cuts, mark_split() gives the vertices in cells of several elements theirs */
+    if (cuts && c >= 0 && c < s->num_cells && s->cell_elem[c + 1] - s->cell_elem[c] > 1) continue;
+    es->elem[i] = fcm_space_point_element(s, c, es->xi + 3 * i);
     FCM_CHECK(es->elem[i] >= 0, ctx, FCM_ERR_ARG,
               "embedded surface: vertex %lld lies in cell %lld, which has no element in this "
               "space (another mesh or active set?)",
               (long long)i, (long long)es->cell[i]);
-    es->flag[i] = 0;
   }
   FCM_ALLOC(ctx, (size_t)es->nbt + 1, split);
   if (rules && fcm_cell_rules_num_cuts(rules) > 0) {
@@ -870,7 +905,8 @@ void fcm_embedded_surface_destroy(fcm_embedded_surface **surface)
   fcm__embed_finder_destroy(&es->finder);
   fcm_aabb_tree_destroy(&es->cell_tree);
   cache_clear(es);
-  void *arrays[] = {es->X, es->xi, es->cell, es->elem, es->tri, es->tri0, es->flag};
+  void *arrays[] = {es->X,    es->xi,   es->cell,     es->elem,   es->tri,
+                    es->tri0, es->flag, es->tc_first, es->tc_ids, es->tc_n};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(es->ctx, arrays[k]);
   fcm__free(es->ctx, es);
