@@ -608,6 +608,11 @@ struct fcm_embedded_surface {
   fcm_index *tc_first, *tc_ids;
   int *tc_n;
   size_t tc_len, tc_cap;
+  /* The last rebuild's cut-face points (cf_np of them, in cell order, room for cf_cap): their
+   * cells, reference coordinates and positions mapped for elements of cf_type. */
+  fcm_index *cf_cell, cf_np, cf_cap;
+  double *cf_xi, *cf_X;
+  fcm_element_type cf_type;
 };
 
 /* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite

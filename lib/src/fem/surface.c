@@ -639,6 +639,32 @@ cleanup:
   return st;
 }
 
+/* Keep the n cut-face points from v (cell order) for the next rebuild. */
+static fcm_status cache_cut_faces(fcm_embedded_surface *es, fcm_index v, fcm_index n)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  es->cf_np = 0;
+  if (n > es->cf_cap) {
+    const size_t cap = (size_t)FCM_MAX(n, 2 * es->cf_cap);
+    fcm__free(ctx, es->cf_cell);
+    fcm__free(ctx, es->cf_xi);
+    fcm__free(ctx, es->cf_X);
+    es->cf_cell = NULL, es->cf_xi = es->cf_X = NULL, es->cf_cap = 0;
+    FCM_ALLOC_RAW(ctx, cap, es->cf_cell);
+    FCM_ALLOC_RAW(ctx, 3 * cap, es->cf_xi);
+    FCM_ALLOC_RAW(ctx, 3 * cap, es->cf_X);
+    es->cf_cap = (fcm_index)cap;
+  }
+  memcpy(es->cf_cell, es->cell + v, (size_t)n * sizeof *es->cf_cell);
+  memcpy(es->cf_xi, es->xi + 3 * v, 3 * (size_t)n * sizeof *es->cf_xi);
+  memcpy(es->cf_X, es->X + 3 * v, 3 * (size_t)n * sizeof *es->cf_X);
+  es->cf_np = n;
+  es->cf_type = es->space->type;
+cleanup:
+  return st;
+}
+
 /* fcm_space_locate() of the n points X in the current space, on the cells' tree. */
 static fcm_status locate(fcm_embedded_surface *es, fcm_index n, const double *X, fcm_index *cell,
                          double *xi)
@@ -801,24 +827,42 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
     v += m;
   }
   FCM_TRY(ctx, part_points(es, es->nb, nsv, ppiece, xat));
+  /* the cut faces, piece by piece (so cell by cell): a point with the cell and the reference
+   * coordinates of the last rebuild's point in its place among its cell's takes its position */
   double Xc[3 * FCM_ELEMENT_MAX_NODES];
+  const fcm_index v0 = v, ncached = es->cf_type == s->type ? es->cf_np : 0;
+  fcm_index j = 0, last = -1, r = 0;
   for (fcm_index p = 0; p < npieces; p++) {
     const double *xi;
     const fcm_index n = fcm_cell_rules_get_piece_cut_faces(rules, p, &xi);
     if (!n) continue;
-    const fcm_index c = fcm_cell_rules_piece_cell(rules, p);
-    fcm_mesh_cell_coords(s->mesh, c, Xc);
-    for (fcm_index k = 0; k < 3 * n; k++, v++) {
-      fcm_element_map(s->type, Xc, xi + 3 * k, es->X + 3 * v);
+    const fcm_index c = fcm_cell_rules_piece_cell(rules, p), e = piece_element(s, c, p);
+    if (c != last) {
+      while (j < ncached && es->cf_cell[j] < c)
+        j++;
+      last = c, r = 0;
+    }
+    int have_xc = 0;
+    for (fcm_index k = 0; k < 3 * n; k++, v++, r++) {
+      const fcm_index q = j + r;
+      if (q < ncached && es->cf_cell[q] == c &&
+          !memcmp(es->cf_xi + 3 * q, xi + 3 * k, 3 * sizeof(double))) {
+        memcpy(es->X + 3 * v, es->cf_X + 3 * q, 3 * sizeof(double));
+      } else {
+        if (!have_xc) fcm_mesh_cell_coords(s->mesh, c, Xc);
+        have_xc = 1;
+        fcm_element_map(s->type, Xc, xi + 3 * k, es->X + 3 * v);
+      }
       memcpy(es->xi + 3 * v, xi + 3 * k, 3 * sizeof(double));
       es->cell[v] = c;
-      es->elem[v] = piece_element(s, c, p);
+      es->elem[v] = e;
       es->flag[v] = 1;
     }
     for (fcm_index k = 0; k < n; k++, t++)
       for (int a = 0; a < 3; a++)
         es->tri[3 * t + a] = v - 3 * n + 3 * k + a;
   }
+  FCM_TRY(ctx, cache_cut_faces(es, v0, v - v0));
   es->np = np;
   es->nt = nt;
   es->num_split = nsplit;
@@ -905,8 +949,8 @@ void fcm_embedded_surface_destroy(fcm_embedded_surface **surface)
   fcm__embed_finder_destroy(&es->finder);
   fcm_aabb_tree_destroy(&es->cell_tree);
   cache_clear(es);
-  void *arrays[] = {es->X,    es->xi,   es->cell,     es->elem,   es->tri,
-                    es->tri0, es->flag, es->tc_first, es->tc_ids, es->tc_n};
+  void *arrays[] = {es->X,        es->xi,     es->cell, es->elem,    es->tri,   es->tri0, es->flag,
+                    es->tc_first, es->tc_ids, es->tc_n, es->cf_cell, es->cf_xi, es->cf_X};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(es->ctx, arrays[k]);
   fcm__free(es->ctx, es);
