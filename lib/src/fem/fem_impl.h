@@ -613,6 +613,7 @@ struct fcm_embedded_surface {
   fcm_index *cf_cell, cf_np, cf_cap;
   double *cf_xi, *cf_X;
   fcm_element_type cf_type;
+  double *tarea; /* nbt zeros: room to add up each split triangle's parts' area */
 };
 
 /* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite

@@ -495,7 +495,7 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
   fcm_ctx *ctx = es->ctx;
   fcm_index *pairs = NULL, *ps = NULL, *pc = NULL;
   size_t *poff = NULL, *xoff = NULL;
-  double *area = NULL, *pxi = NULL;
+  double *area, *pxi = NULL;
   size_t n = 0, cap = 0, pcap = 0, xcap = 0;
   FCM_TRY(ctx, cell_tree(es));
   for (fcm_index t = 0; t < es->nbt; t++) {
@@ -568,8 +568,10 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
   poff[n] = polys->n, xoff[n] = polys->nx;
   if (!pxi) FCM_ALLOC_RAW(ctx, 3, pxi);
   FCM_TRY(ctx, cache_parts(es, polys, &pairs, n, &poff, &xoff, &pxi));
-  /* the parts cover each triangle: else it stays whole */
-  FCM_ALLOC(ctx, (size_t)es->nbt + 1, area);
+  /* the parts cover each triangle: else it stays whole (es->tarea: zero between rebuilds, so
+   * that its pages are not zeroed again each time) */
+  if (!es->tarea) FCM_ALLOC(ctx, (size_t)es->nbt + 1, es->tarea);
+  area = es->tarea;
   for (size_t j = 0, off = 0; j < polys->n; off += (size_t)polys->nv[j], j++) {
     const double *x = polys->x + 3 * off;
     for (int k = 1; k + 1 < polys->nv[j]; k++)
@@ -582,6 +584,8 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
     const double a = tri_area(x, x + 3, x + 6);
     if (!(fabs(area[t] - a) <= SPLIT_AREA_RTOL * a)) split[t] = 0;
   }
+  for (size_t j = 0; j < polys->n; j++)
+    area[ps[j]] = 0.0;
   *src = ps, *pcell = pc;
   ps = pc = NULL;
 cleanup:
@@ -590,7 +594,6 @@ cleanup:
   fcm__free(ctx, xoff);
   fcm__free(ctx, ps);
   fcm__free(ctx, pc);
-  fcm__free(ctx, area);
   fcm__free(ctx, pxi);
   return st;
 }
@@ -949,8 +952,9 @@ void fcm_embedded_surface_destroy(fcm_embedded_surface **surface)
   fcm__embed_finder_destroy(&es->finder);
   fcm_aabb_tree_destroy(&es->cell_tree);
   cache_clear(es);
-  void *arrays[] = {es->X,        es->xi,     es->cell, es->elem,    es->tri,   es->tri0, es->flag,
-                    es->tc_first, es->tc_ids, es->tc_n, es->cf_cell, es->cf_xi, es->cf_X};
+  void *arrays[] = {es->X,       es->xi,    es->cell,     es->elem,   es->tri,
+                    es->tri0,    es->flag,  es->tc_first, es->tc_ids, es->tc_n,
+                    es->cf_cell, es->cf_xi, es->cf_X,     es->tarea};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(es->ctx, arrays[k]);
   fcm__free(es->ctx, es);
