@@ -663,7 +663,6 @@ static fcm_status cache_cut_faces(fcm_embedded_surface *es, fcm_index v, fcm_ind
   memcpy(es->cf_xi, es->xi + 3 * v, 3 * (size_t)n * sizeof *es->cf_xi);
   memcpy(es->cf_X, es->X + 3 * v, 3 * (size_t)n * sizeof *es->cf_X);
   es->cf_np = n;
-  es->cf_type = es->space->type;
 cleanup:
   return st;
 }
@@ -697,11 +696,6 @@ static fcm_status part_points(fcm_embedded_surface *es, fcm_index v, fcm_index n
   fcm_index last = -1, *lost = NULL, nlost = 0;
   double *lx = NULL, *lxi = NULL;
   fcm_index *lc = NULL;
-  if (es->pxi && es->pxi_type != s->type) { /* mapped for other elements */
-    for (size_t k = 0; k < 3 * es->polys.nx; k++)
-      es->pxi[k] = NAN;
-    es->pxi_type = s->type;
-  }
   for (fcm_index i = v; i < v + n; i++) {
     const fcm_index c = es->cell[i];
     double *kept = es->pxi ? es->pxi + 3 * xat[i - v] : NULL;
@@ -833,7 +827,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   /* the cut faces, piece by piece (so cell by cell): a point with the cell and the reference
    * coordinates of the last rebuild's point in its place among its cell's takes its position */
   double Xc[3 * FCM_ELEMENT_MAX_NODES];
-  const fcm_index v0 = v, ncached = es->cf_type == s->type ? es->cf_np : 0;
+  const fcm_index v0 = v, ncached = es->cf_np;
   fcm_index j = 0, last = -1, r = 0;
   for (fcm_index p = 0; p < npieces; p++) {
     const double *xi;
