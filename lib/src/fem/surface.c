@@ -264,7 +264,7 @@ static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, const fcm_ind
   fcm__idbuf q = {NULL, 0, 0};
   if (!es->tc_first) {
     fcm_index *first = NULL;
-    FCM_ALLOC_RAW(ctx, (size_t)es->nbt + 1, es->tc_n);
+    if (!es->tc_n) FCM_ALLOC_RAW(ctx, (size_t)es->nbt + 1, es->tc_n);
     FCM_ALLOC_RAW(ctx, (size_t)es->nbt + 1, first);
     for (fcm_index k = 0; k < es->nbt; k++)
       first[k] = -1;
