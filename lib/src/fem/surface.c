@@ -648,6 +648,7 @@ static fcm_status cache_cut_faces(fcm_embedded_surface *es, fcm_index v, fcm_ind
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
   es->cf_np = 0;
+  if (n == 0) return FCM_OK;
   if (n > es->cf_cap) {
     const size_t cap = (size_t)FCM_MAX(n, 2 * es->cf_cap);
     fcm__free(ctx, es->cf_cell);
