@@ -147,3 +147,8 @@ fcm_add_test(embed_cut_reuse tests/embed/cut_reuse.c)
 # slabs of the unit cell thinner than 4 prism half-heights are not flagged on the face they
 # lie on, thicker ones are; parts not full never are.
 fcm_add_test(embed_face_full tests/embed/face_full.c)
+# The embedded surface's pieces' finder: points near a cut (on it, off it by more than the
+# width, beyond its edges; nothing without cuts), every point two pieces hold near a cut,
+# points off the cut in one piece, and the same answers after the finder is released and the
+# rules set again.
+fcm_add_test(embed_finder tests/embed/finder.c)

@@ -12,7 +12,8 @@
  * - the boundary triangles no cut reaches are the geometry's own, in their order.
  * - the surface set to each cut space (the second reusing what the first cut found in the
  *   cells the second does not reach) has the bits of one made on that space anew: points,
- *   triangles, flags and the displacements of a field.
+ *   triangles, flags and the displacements of a field; so has the surface set back to it
+ *   from a space of the same rules (every answer taken from what that rebuild kept).
  * The same for a box cut along cell faces through its boundary vertices, and for a box of 12
  * boundary triangles cut by the ball's planes (far more part points and cut faces than
  * boundary vertices: the surface's arrays grow, in its creation and at each cut).
@@ -307,6 +308,7 @@ static void run(fcm_element_type type, fcm_geometry *g, int ncut, const double (
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, free_space));
     check(free_space, es, g, k + 1, (const double(*)[3])at, pn, h, 1);
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, s[k + 1]));
+    same_as_new(es, s[k + 1], g); /* all from what the rebuild on free_space kept */
     fcm_space_destroy(&free_space);
   }
 done:

@@ -433,6 +433,16 @@ fcm_status fcm__embed_finder_set_rules(fcm__embed_finder *f, const fcm_cell_rule
  * cut's edge may count, one that a cut crosses always does). 0 without cuts. */
 fcm_status fcm__embed_finder_crosses(fcm__embed_finder *f, const double x[9], int *crosses);
 
+/* Whether point x lies within w of a cut triangle of R: within w of its plane and inside its
+ * three edge planes pushed out by w (0 without cuts). A point that parts of two pieces hold
+ * (fcm__embed_finder_point() gives -2) lies on a cut triangle within the cuts' tolerance. */
+fcm_status fcm__embed_finder_near_cut(fcm__embed_finder *f, const double x[3], double w, int *near);
+
+/* Free what the finder holds for its rules (the cut triangles' tree, the current cell's parts
+ * and the work space), keeping what it holds for its mesh and geometry; set rules again
+ * before the next question. NULL: nothing. */
+void fcm__embed_finder_release(fcm__embed_finder *f);
+
 /* The piece of R that holds point x of cell c, x on the boundary of the material: the piece of
  * every part containing x within the cuts' tolerance (FCM__EMBED_MATCH_RTOL of the cell size).
  * *piece = -1 when no part of a piece does, -2 when parts of several pieces do (x on a cut). */

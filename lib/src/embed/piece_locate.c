@@ -76,12 +76,7 @@ void fcm__embed_finder_destroy(fcm__embed_finder **finder)
 {
   if (!finder || !*finder) return;
   fcm__embed_finder *f = *finder;
-  fcm_aabb_tree_destroy(&f->cut_tree);
-  fcm__geom_idbuf_free(f->ctx, &f->cand);
-  fcm__embed_ws_free(f->ctx, &f->ws);
-  if (f->P) fcm__embed_parts_free(f->ctx, f->P);
-  fcm__free(f->ctx, f->P);
-  fcm__free(f->ctx, f->piece);
+  fcm__embed_finder_release(f);
   fcm__free(f->ctx, f);
   *finder = NULL;
 }
@@ -203,6 +198,40 @@ fcm_status fcm__embed_finder_crosses(fcm__embed_finder *f, const double x[9], in
   }
 cleanup:
   return st;
+}
+
+fcm_status fcm__embed_finder_near_cut(fcm__embed_finder *f, const double x[3], double w, int *near)
+{
+  fcm_status st = FCM_OK;
+  double lo[3], hi[3];
+  *near = 0;
+  if (!f->cut_tree) return FCM_OK;
+  for (int d = 0; d < 3; d++)
+    lo[d] = x[d] - w, hi[d] = x[d] + w;
+  FCM_TRY(f->ctx, fcm__geom_tree_query(f->ctx, f->cut_tree, lo, hi, &f->cand));
+  for (size_t k = 0; k < f->cand.n && !*near; k++) {
+    const fcm__cut_tri *t = f->R->cut_tris + f->cand.ids[k];
+    int on = fabs(fcm__vec3_dot(t->plane.n, x) - t->plane.d) <= w;
+    for (int e = 0; e < 3 && on; e++)
+      on = fcm__vec3_dot(t->edge[e].n, x) - t->edge[e].d <= w;
+    *near = on;
+  }
+cleanup:
+  return st;
+}
+
+void fcm__embed_finder_release(fcm__embed_finder *f)
+{
+  if (!f) return;
+  fcm_aabb_tree_destroy(&f->cut_tree);
+  fcm__geom_idbuf_free(f->ctx, &f->cand);
+  fcm__embed_ws_free(f->ctx, &f->ws);
+  memset(&f->ws, 0, sizeof f->ws);
+  if (f->P) fcm__embed_parts_free(f->ctx, f->P);
+  fcm__free(f->ctx, f->P);
+  fcm__free(f->ctx, f->piece);
+  f->P = NULL, f->piece = NULL, f->piece_cap = 0;
+  f->R = NULL, f->cell = -1, f->has_parts = 0;
 }
 
 fcm_status fcm__embed_finder_point(fcm__embed_finder *f, fcm_index c, const double x[3],

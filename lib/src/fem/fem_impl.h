@@ -598,6 +598,19 @@ struct fcm_embedded_surface {
   unsigned char *cross;        /* nbt: whether a cut triangle of those rules crosses triangle t */
   size_t npairs, *poff, *xoff; /* xoff: pair k's first polygon vertex */
   fcm__embed_polys polys;
+  /* 3 per vertex of polys: its reference coordinates in its pair's cell (NaN: not mapped) */
+  double *pxi;
+  /* The cells each boundary triangle's box meets (the geometry's and mesh's, fixed), found
+   * when first needed: triangle t's tc_n[t] cells from tc_ids[tc_first[t]] (tc_first[t] < 0:
+   * not yet; NULL: none found yet), tc_len of tc_cap used. */
+  fcm_index *tc_first, *tc_ids;
+  int *tc_n;
+  size_t tc_len, tc_cap;
+  /* The last rebuild's cut-face points (cf_np of them, in cell order, room for cf_cap): their
+   * cells, reference coordinates and positions (the mesh's element type is the spaces'). */
+  fcm_index *cf_cell, cf_np, cf_cap;
+  double *cf_xi, *cf_X;
+  double *tarea; /* nbt zeros: room to add up each split triangle's parts' area */
 };
 
 /* fcm_space_write_vtu() and fcm_embedded_surface_write_vtu() that also count, in *nonfinite

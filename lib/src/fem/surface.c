@@ -140,13 +140,13 @@ cleanup:
 static void cache_clear(fcm_embedded_surface *es)
 {
   void *arrays[] = {es->prev_tris, es->prev_piece_off, es->vpiece, es->pairs,
-                    es->poff,      es->xoff,           es->cross};
+                    es->poff,      es->xoff,           es->cross,  es->pxi};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(es->ctx, arrays[k]);
   fcm__embed_polys_free(es->ctx, &es->polys);
   es->prev_tris = NULL, es->prev_piece_off = es->vpiece = es->pairs = NULL;
   es->poff = es->xoff = NULL;
-  es->cross = NULL;
+  es->cross = NULL, es->pxi = NULL;
   es->prev_ntris = es->prev_ncells = 0;
   es->npairs = 0;
 }
@@ -173,9 +173,11 @@ cleanup:
 }
 
 /* Keep the clipped parts of the (cell, triangle) pairs (*pairs, n, sorted) for the next
- * rebuild: the arrays are taken, the polygons copied. */
+ * rebuild, with their vertices' reference coordinates (*pxi, 3 per vertex of polys; NaN: not
+ * mapped yet): the arrays are taken, the polygons copied. */
 static fcm_status cache_parts(fcm_embedded_surface *es, const fcm__embed_polys *polys,
-                              fcm_index **pairs, size_t n, size_t **poff, size_t **xoff)
+                              fcm_index **pairs, size_t n, size_t **poff, size_t **xoff,
+                              double **pxi)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
@@ -194,8 +196,10 @@ static fcm_status cache_parts(fcm_embedded_surface *es, const fcm__embed_polys *
   fcm__free(ctx, es->pairs);
   fcm__free(ctx, es->poff);
   fcm__free(ctx, es->xoff);
+  fcm__free(ctx, es->pxi);
   es->pairs = *pairs, es->poff = *poff, es->xoff = *xoff, es->npairs = n;
-  *pairs = NULL, *poff = NULL, *xoff = NULL;
+  es->pxi = *pxi;
+  *pairs = NULL, *poff = NULL, *xoff = NULL, *pxi = NULL;
 cleanup:
   fcm__embed_polys_free(ctx, &copy);
   return st;
@@ -251,19 +255,51 @@ static void preclip_free(fcm_ctx *ctx, preclip *pc)
   memset(pc, 0, sizeof *pc);
 }
 
-/* The cells boundary triangle t touches within rounding, into ids. */
-static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, fcm__idbuf *ids)
+/* The cells boundary triangle t touches within rounding: *n of them from *ids (valid until the
+ * next call), found once a surface (es->tc_*: they depend on the geometry and mesh alone). */
+static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, const fcm_index **ids, size_t *n)
 {
-  double x[9], lo[3], hi[3], w = 0.0;
-  tri_coords(es, t, x);
-  for (int d = 0; d < 3; d++) {
-    lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d]));
-    hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d]));
-    w = fmax(w, hi[d] - lo[d]);
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  fcm__idbuf q = {NULL, 0, 0};
+  if (!es->tc_first) {
+    fcm_index *first = NULL;
+    if (!es->tc_n) FCM_ALLOC_RAW(ctx, (size_t)es->nbt + 1, es->tc_n);
+    FCM_ALLOC_RAW(ctx, (size_t)es->nbt + 1, first);
+    for (fcm_index k = 0; k < es->nbt; k++)
+      first[k] = -1;
+    es->tc_first = first;
   }
-  for (int d = 0; d < 3; d++)
-    lo[d] -= 1e-9 * w, hi[d] += 1e-9 * w;
-  return fcm__geom_tree_query(es->ctx, es->cell_tree, lo, hi, ids);
+  if (es->tc_first[t] < 0) {
+    double x[9], lo[3], hi[3], w = 0.0;
+    tri_coords(es, t, x);
+    for (int d = 0; d < 3; d++) {
+      lo[d] = fmin(x[d], fmin(x[3 + d], x[6 + d]));
+      hi[d] = fmax(x[d], fmax(x[3 + d], x[6 + d]));
+      w = fmax(w, hi[d] - lo[d]);
+    }
+    for (int d = 0; d < 3; d++)
+      lo[d] -= 1e-9 * w, hi[d] += 1e-9 * w;
+    FCM_TRY(ctx, fcm__geom_tree_query(ctx, es->cell_tree, lo, hi, &q));
+    if (es->tc_len + q.n > es->tc_cap) {
+      size_t cap = es->tc_cap ? 2 * es->tc_cap : 4096;
+      while (cap < es->tc_len + q.n)
+        cap *= 2;
+      void *a = es->tc_ids;
+      FCM_TRY(ctx, fcm__resize(ctx, &a, es->tc_len, cap, sizeof(fcm_index)));
+      es->tc_ids = a;
+      es->tc_cap = cap;
+    }
+    memcpy(es->tc_ids + es->tc_len, q.ids, q.n * sizeof *q.ids);
+    es->tc_first[t] = (fcm_index)es->tc_len;
+    es->tc_n[t] = (int)q.n;
+    es->tc_len += q.n;
+  }
+  *ids = es->tc_ids + es->tc_first[t];
+  *n = (size_t)es->tc_n[t];
+cleanup:
+  fcm__geom_idbuf_free(ctx, &q);
+  return st;
 }
 
 /* The (cell, triangle) pairs split_triangles() may clip in the cells the vertices' pieces load
@@ -274,15 +310,15 @@ static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *c
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
-  fcm__idbuf ids = {NULL, 0, 0};
   size_t cap = 0;
   FCM_TRY(ctx, cell_tree(es));
   for (fcm_index t = 0; t < es->nbt; t++) {
-    const fcm_index *v = es->tri0 + 3 * t;
+    const fcm_index *v = es->tri0 + 3 * t, *ids;
+    size_t nids;
     if (!crosses[t] && !maybe[v[0]] && !maybe[v[1]] && !maybe[v[2]]) continue;
-    FCM_TRY(ctx, tri_cells(es, t, &ids));
-    for (size_t k = 0; k < ids.n; k++) {
-      if (!qcell[ids.ids[k]]) continue;
+    FCM_TRY(ctx, tri_cells(es, t, &ids, &nids));
+    for (size_t k = 0; k < nids; k++) {
+      if (!qcell[ids[k]]) continue;
       if (pc->n == cap) {
         const size_t ncap = cap ? 2 * cap : 1024;
         void *q = pc->pairs;
@@ -290,7 +326,7 @@ static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *c
         pc->pairs = q;
         cap = ncap;
       }
-      pc->pairs[2 * pc->n] = ids.ids[k], pc->pairs[2 * pc->n + 1] = t;
+      pc->pairs[2 * pc->n] = ids[k], pc->pairs[2 * pc->n + 1] = t;
       pc->n++;
     }
   }
@@ -298,19 +334,29 @@ static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *c
   FCM_ALLOC_RAW(ctx, pc->n + 1, pc->off);
   FCM_ALLOC_RAW(ctx, pc->n + 1, pc->xoff);
 cleanup:
-  fcm__geom_idbuf_free(ctx, &ids);
   return st;
 }
 
-/* Clip the pairs of cell c from *k on (the finder holds c's parts). */
-static fcm_status preclip_cell(fcm_embedded_surface *es, fcm_index c, preclip *pc, size_t *k)
+/* Clip the pairs of cell c from *k on (the finder holds c's parts), but those of triangles
+ * known by now to stay whole: no cut crosses them (crosses) and each vertex is either known
+ * off the cuts (on_cut, once looked up: a vertex in a cell up to c, or one whose answer is
+ * kept; `lookup` flags the vertices looked up in this rebuild) or not near one (maybe). What
+ * is left out here and split after all is clipped by split_triangles(). */
+static fcm_status preclip_cell(fcm_embedded_surface *es, fcm_index c, const unsigned char *crosses,
+                               const unsigned char *maybe, const unsigned char *on_cut,
+                               const unsigned char *lookup, preclip *pc, size_t *k)
 {
   fcm_status st = FCM_OK;
   for (; *k < pc->n && pc->pairs[2 * *k] <= c; ++*k) {
     pc->off[*k] = pc->polys.n, pc->xoff[*k] = pc->polys.nx;
     if (pc->pairs[2 * *k] < c) continue;
+    const fcm_index t = pc->pairs[2 * *k + 1], *v = es->tri0 + 3 * t;
+    int may = crosses[t];
+    for (int a = 0; a < 3 && !may; a++)
+      may = lookup[v[a]] && es->cell[v[a]] > c ? maybe[v[a]] : on_cut[v[a]];
+    if (!may) continue;
     double x[9];
-    tri_coords(es, pc->pairs[2 * *k + 1], x);
+    tri_coords(es, t, x);
     FCM_TRY(es->ctx, fcm__embed_finder_clip(es->finder, c, x, &pc->polys));
   }
 cleanup:
@@ -378,9 +424,11 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
   const fcm_space *s = es->space;
   fcm__embed_finder *f = es->finder;
   fcm_index *pairs = NULL, *vpiece = NULL, n = 0;
-  unsigned char *on_cut = NULL, *maybe = NULL, *qcell = NULL;
+  unsigned char *on_cut = NULL, *maybe = NULL, *qcell = NULL, *lookup = NULL;
   FCM_ALLOC(ctx, (size_t)es->nb + 1, on_cut);
   FCM_ALLOC(ctx, (size_t)es->nb + 1, maybe);
+  FCM_ALLOC(ctx, (size_t)es->nb + 1, lookup);
+  FCM_TRY(ctx, cell_tree(es)); /* cell_pad */
   FCM_ALLOC(ctx, (size_t)fcm_mesh_num_cells(es->mesh) + 1, qcell);
   FCM_ALLOC_RAW(ctx, 2 * (size_t)es->nb + 2, pairs);
   FCM_ALLOC_RAW(ctx, (size_t)es->nb + 1, vpiece);
@@ -390,13 +438,16 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
     if (s->cell_elem[c + 1] - s->cell_elem[c] <= 1) continue;
     if (es->vpiece && !changed[c] && es->vpiece[i] != -3) { /* as the last rebuild found */
       const fcm_index p = map_piece(es, c, es->vpiece[i]), e = piece_element(s, c, p);
-      if (e >= 0) es->elem[i] = e;
+      es->elem[i] = e >= 0 ? e : fcm_space_point_element(s, c, es->xi + 3 * i);
       on_cut[i] = maybe[i] = p == -2;
       vpiece[i] = p;
       continue;
     }
     pairs[2 * n] = c, pairs[2 * n + 1] = i, n++;
-    maybe[i] = qcell[c] = 1;
+    int near = 0; /* a vertex on a cut lies on a cut triangle: the pad is far above its tolerance */
+    FCM_TRY(ctx, fcm__embed_finder_near_cut(f, es->X + 3 * i, es->cell_pad, &near));
+    maybe[i] = (unsigned char)near;
+    lookup[i] = qcell[c] = 1;
   }
   FCM_TRY(ctx, cut_crossings(es, extends, split)); /* the cuts' triangles alone decide */
   FCM_TRY(ctx, preclip_pairs(es, split, maybe, qcell, pc));
@@ -407,12 +458,14 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
     fcm_index p = -1;
     FCM_TRY(ctx, fcm__embed_finder_point(f, c, es->X + 3 * i, &p));
     const fcm_index e = piece_element(s, c, p);
-    if (e >= 0) es->elem[i] = e;
+    es->elem[i] = e >= 0 ? e : fcm_space_point_element(s, c, es->xi + 3 * i);
     on_cut[i] = p == -2;
     vpiece[i] = p;
-    if (k + 1 == n || pairs[2 * (k + 1)] != c) FCM_TRY(ctx, preclip_cell(es, c, pc, &kc));
+    if (k + 1 == n || pairs[2 * (k + 1)] != c)
+      FCM_TRY(ctx, preclip_cell(es, c, split, maybe, on_cut, lookup, pc, &kc));
   }
-  FCM_TRY(ctx, preclip_cell(es, fcm_mesh_num_cells(es->mesh), pc, &kc));
+  FCM_TRY(ctx,
+          preclip_cell(es, fcm_mesh_num_cells(es->mesh), split, maybe, on_cut, lookup, pc, &kc));
   pc->off[pc->n] = pc->polys.n, pc->xoff[pc->n] = pc->polys.nx;
   fcm__free(ctx, es->vpiece);
   es->vpiece = vpiece;
@@ -426,6 +479,7 @@ cleanup:
   fcm__free(ctx, vpiece);
   fcm__free(ctx, on_cut);
   fcm__free(ctx, maybe);
+  fcm__free(ctx, lookup);
   fcm__free(ctx, qcell);
   return st;
 }
@@ -441,24 +495,25 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
   fcm_ctx *ctx = es->ctx;
   fcm_index *pairs = NULL, *ps = NULL, *pc = NULL;
   size_t *poff = NULL, *xoff = NULL;
-  double *area = NULL;
-  size_t n = 0, cap = 0, pcap = 0;
-  fcm__idbuf ids = {NULL, 0, 0};
+  double *area, *pxi = NULL;
+  size_t n = 0, cap = 0, pcap = 0, xcap = 0;
   FCM_TRY(ctx, cell_tree(es));
   for (fcm_index t = 0; t < es->nbt; t++) {
+    const fcm_index *ids;
+    size_t nids;
     if (!split[t]) continue;
-    FCM_TRY(ctx, tri_cells(es, t, &ids));
-    if (n + ids.n > cap) {
+    FCM_TRY(ctx, tri_cells(es, t, &ids, &nids));
+    if (n + nids > cap) {
       size_t ncap = cap ? 2 * cap : 1024;
-      while (ncap < n + ids.n)
+      while (ncap < n + nids)
         ncap *= 2;
       void *q = pairs;
       FCM_TRY(ctx, fcm__resize(ctx, &q, 2 * n, 2 * ncap, sizeof(fcm_index)));
       pairs = q;
       cap = ncap;
     }
-    for (size_t k = 0; k < ids.n; k++, n++)
-      pairs[2 * n] = ids.ids[k], pairs[2 * n + 1] = t;
+    for (size_t k = 0; k < nids; k++, n++)
+      pairs[2 * n] = ids[k], pairs[2 * n + 1] = t;
   }
   qsort(pairs, n, 2 * sizeof *pairs, cmp_pair); /* one cell's parts made once */
   FCM_ALLOC_RAW(ctx, n + 1, poff);
@@ -471,7 +526,8 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
       j++;
     while (jp < pre->n && cmp_pair(pre->pairs + 2 * jp, pairs + 2 * k) < 0)
       jp++;
-    if (!changed[c] && j < es->npairs && !cmp_pair(es->pairs + 2 * j, pairs + 2 * k)) {
+    const int reused = !changed[c] && j < es->npairs && !cmp_pair(es->pairs + 2 * j, pairs + 2 * k);
+    if (reused) {
       size_t first_x = es->xoff[j]; /* the parts the last rebuild clipped */
       for (size_t q = es->poff[j]; q < es->poff[j + 1]; first_x += (size_t)es->polys.nv[q++])
         FCM_TRY(ctx, polys_append(ctx, polys, &es->polys, q, first_x,
@@ -485,6 +541,18 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
       tri_coords(es, t, x);
       FCM_TRY(ctx, fcm__embed_finder_clip(es->finder, c, x, polys));
     }
+    if (polys->nx > xcap) {
+      const size_t ncap = FCM_MAX(2 * xcap, polys->nx + 1024);
+      void *a = pxi;
+      FCM_TRY(ctx, fcm__resize(ctx, &a, 3 * xcap, 3 * ncap, sizeof(double)));
+      pxi = a;
+      xcap = ncap;
+    }
+    if (reused && es->pxi)
+      memcpy(pxi + 3 * xoff[k], es->pxi + 3 * es->xoff[j], 3 * (polys->nx - xoff[k]) * sizeof *pxi);
+    else
+      for (size_t q = 3 * xoff[k]; q < 3 * polys->nx; q++)
+        pxi[q] = NAN;
     if (polys->n > pcap) {
       const size_t ncap = FCM_MAX(2 * pcap, polys->n + 256);
       void *a = ps, *b = pc;
@@ -498,9 +566,12 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
       ps[q] = t, pc[q] = c;
   }
   poff[n] = polys->n, xoff[n] = polys->nx;
-  FCM_TRY(ctx, cache_parts(es, polys, &pairs, n, &poff, &xoff));
-  /* the parts cover each triangle: else it stays whole */
-  FCM_ALLOC(ctx, (size_t)es->nbt + 1, area);
+  if (!pxi) FCM_ALLOC_RAW(ctx, 3, pxi);
+  FCM_TRY(ctx, cache_parts(es, polys, &pairs, n, &poff, &xoff, &pxi));
+  /* the parts cover each triangle: else it stays whole (es->tarea: zero between rebuilds, so
+   * that its pages are not zeroed again each time) */
+  if (!es->tarea) FCM_ALLOC(ctx, (size_t)es->nbt + 1, es->tarea);
+  area = es->tarea;
   for (size_t j = 0, off = 0; j < polys->n; off += (size_t)polys->nv[j], j++) {
     const double *x = polys->x + 3 * off;
     for (int k = 1; k + 1 < polys->nv[j]; k++)
@@ -513,6 +584,8 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
     const double a = tri_area(x, x + 3, x + 6);
     if (!(fabs(area[t] - a) <= SPLIT_AREA_RTOL * a)) split[t] = 0;
   }
+  for (size_t j = 0; j < polys->n; j++)
+    area[ps[j]] = 0.0;
   *src = ps, *pcell = pc;
   ps = pc = NULL;
 cleanup:
@@ -521,8 +594,7 @@ cleanup:
   fcm__free(ctx, xoff);
   fcm__free(ctx, ps);
   fcm__free(ctx, pc);
-  fcm__free(ctx, area);
-  fcm__geom_idbuf_free(ctx, &ids);
+  fcm__free(ctx, pxi);
   return st;
 }
 
@@ -570,6 +642,32 @@ cleanup:
   return st;
 }
 
+/* Keep the n cut-face points from v (cell order) for the next rebuild. */
+static fcm_status cache_cut_faces(fcm_embedded_surface *es, fcm_index v, fcm_index n)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = es->ctx;
+  es->cf_np = 0;
+  if (n == 0) return FCM_OK;
+  if (n > es->cf_cap) {
+    const size_t cap = (size_t)FCM_MAX(n, 2 * es->cf_cap);
+    fcm__free(ctx, es->cf_cell);
+    fcm__free(ctx, es->cf_xi);
+    fcm__free(ctx, es->cf_X);
+    es->cf_cell = NULL, es->cf_xi = es->cf_X = NULL, es->cf_cap = 0;
+    FCM_ALLOC_RAW(ctx, cap, es->cf_cell);
+    FCM_ALLOC_RAW(ctx, 3 * cap, es->cf_xi);
+    FCM_ALLOC_RAW(ctx, 3 * cap, es->cf_X);
+    es->cf_cap = (fcm_index)cap;
+  }
+  memcpy(es->cf_cell, es->cell + v, (size_t)n * sizeof *es->cf_cell);
+  memcpy(es->cf_xi, es->xi + 3 * v, 3 * (size_t)n * sizeof *es->cf_xi);
+  memcpy(es->cf_X, es->X + 3 * v, 3 * (size_t)n * sizeof *es->cf_X);
+  es->cf_np = n;
+cleanup:
+  return st;
+}
+
 /* fcm_space_locate() of the n points X in the current space, on the cells' tree. */
 static fcm_status locate(fcm_embedded_surface *es, fcm_index n, const double *X, fcm_index *cell,
                          double *xi)
@@ -587,9 +685,10 @@ cleanup:
 /* Points [v, v + n) of the split triangles' parts: reference coordinates in their cells and
  * elements. A part no piece holds (in a dropped cell or piece) follows the element
  * fcm_space_point_element() picks, in the cell fcm_space_locate() finds when its own has no
- * element. */
+ * element. Point i is vertex xat[i - v] of es->polys: its reference coordinates in its cell
+ * are taken from es->pxi where mapped, else mapped and kept there. */
 static fcm_status part_points(fcm_embedded_surface *es, fcm_index v, fcm_index n,
-                              const fcm_index *piece)
+                              const fcm_index *piece, const size_t *xat)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = es->ctx;
@@ -600,9 +699,15 @@ static fcm_status part_points(fcm_embedded_surface *es, fcm_index v, fcm_index n
   fcm_index *lc = NULL;
   for (fcm_index i = v; i < v + n; i++) {
     const fcm_index c = es->cell[i];
-    if (c != last) fcm_mesh_cell_coords(es->mesh, c, X);
-    last = c;
-    FCM_TRY(ctx, fcm_element_inverse_map(ctx, s->type, X, es->X + 3 * i, es->xi + 3 * i));
+    double *kept = es->pxi ? es->pxi + 3 * xat[i - v] : NULL;
+    if (kept && !isnan(kept[0])) {
+      memcpy(es->xi + 3 * i, kept, 3 * sizeof *kept);
+    } else {
+      if (c != last) fcm_mesh_cell_coords(es->mesh, c, X);
+      last = c;
+      FCM_TRY(ctx, fcm_element_inverse_map(ctx, s->type, X, es->X + 3 * i, es->xi + 3 * i));
+      if (kept) memcpy(kept, es->xi + 3 * i, 3 * sizeof *kept);
+    }
     es->elem[i] = piece_element(s, c, piece[i - v]);
     if (es->elem[i] < 0) es->elem[i] = fcm_space_point_element(s, c, es->xi + 3 * i);
     if (es->elem[i] < 0) {
@@ -646,17 +751,21 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   preclip pre;
   fcm_index *src = NULL, *pcell = NULL, *order = NULL, *ppiece = NULL, *by_tri = NULL;
   memset(&pre, 0, sizeof pre);
-  size_t *first_x = NULL;
+  size_t *first_x = NULL, *xat = NULL;
   fcm_index ncf = 0;
   for (fcm_index p = 0; p < npieces; p++)
     ncf += fcm_cell_rules_get_piece_cut_faces(rules, p, NULL);
+  const int cuts = rules && fcm_cell_rules_num_cuts(rules) > 0;
   for (fcm_index i = 0; i < es->nb; i++) {
-    es->elem[i] = fcm_space_point_element(s, es->cell[i], es->xi + 3 * i);
+    const fcm_index c = es->cell[i];
+    es->flag[i] = 0;
+    /* with cuts, mark_split() gives the vertices in cells of several elements theirs */
+    if (cuts && c >= 0 && c < s->num_cells && s->cell_elem[c + 1] - s->cell_elem[c] > 1) continue;
+    es->elem[i] = fcm_space_point_element(s, c, es->xi + 3 * i);
     FCM_CHECK(es->elem[i] >= 0, ctx, FCM_ERR_ARG,
               "embedded surface: vertex %lld lies in cell %lld, which has no element in this "
               "space (another mesh or active set?)",
               (long long)i, (long long)es->cell[i]);
-    es->flag[i] = 0;
   }
   FCM_ALLOC(ctx, (size_t)es->nbt + 1, split);
   if (rules && fcm_cell_rules_num_cuts(rules) > 0) {
@@ -697,6 +806,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
   for (fcm_index k = 0; k < es->nbt; k++)
     if (!split[k]) memcpy(es->tri + 3 * t++, es->tri0 + 3 * k, 3 * sizeof *es->tri);
   FCM_ALLOC(ctx, (size_t)nsv + 1, ppiece);
+  FCM_ALLOC_RAW(ctx, (size_t)nsv + 1, xat);
   for (fcm_index k = 0; k < nkeep; k++) {
     const fcm_index j = order[k];
     const int m = polys.nv[j];
@@ -705,6 +815,7 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
       es->cell[v + a] = pcell[j];
       es->flag[v + a] = 0;
       ppiece[v + a - es->nb] = polys.piece[j];
+      xat[v + a - es->nb] = first_x[j] + (size_t)a;
     }
     for (int a = 1; a + 1 < m; a++, t++) { /* fan: the polygon keeps the triangle's orientation */
       es->tri[3 * t] = v;
@@ -713,33 +824,52 @@ static fcm_status surface_rebuild(fcm_embedded_surface *es)
     }
     v += m;
   }
-  FCM_TRY(ctx, part_points(es, es->nb, nsv, ppiece));
+  FCM_TRY(ctx, part_points(es, es->nb, nsv, ppiece, xat));
+  /* the cut faces, piece by piece (so cell by cell): a point with the cell and the reference
+   * coordinates of the last rebuild's point in its place among its cell's takes its position */
   double Xc[3 * FCM_ELEMENT_MAX_NODES];
+  const fcm_index v0 = v, ncached = es->cf_np;
+  fcm_index j = 0, last = -1, r = 0;
   for (fcm_index p = 0; p < npieces; p++) {
     const double *xi;
     const fcm_index n = fcm_cell_rules_get_piece_cut_faces(rules, p, &xi);
     if (!n) continue;
-    const fcm_index c = fcm_cell_rules_piece_cell(rules, p);
-    fcm_mesh_cell_coords(s->mesh, c, Xc);
-    for (fcm_index k = 0; k < 3 * n; k++, v++) {
-      fcm_element_map(s->type, Xc, xi + 3 * k, es->X + 3 * v);
+    const fcm_index c = fcm_cell_rules_piece_cell(rules, p), e = piece_element(s, c, p);
+    if (c != last) {
+      while (j < ncached && es->cf_cell[j] < c)
+        j++;
+      last = c, r = 0;
+    }
+    int have_xc = 0;
+    for (fcm_index k = 0; k < 3 * n; k++, v++, r++) {
+      const fcm_index q = j + r;
+      if (q < ncached && es->cf_cell[q] == c &&
+          !memcmp(es->cf_xi + 3 * q, xi + 3 * k, 3 * sizeof(double))) {
+        memcpy(es->X + 3 * v, es->cf_X + 3 * q, 3 * sizeof(double));
+      } else {
+        if (!have_xc) fcm_mesh_cell_coords(s->mesh, c, Xc);
+        have_xc = 1;
+        fcm_element_map(s->type, Xc, xi + 3 * k, es->X + 3 * v);
+      }
       memcpy(es->xi + 3 * v, xi + 3 * k, 3 * sizeof(double));
       es->cell[v] = c;
-      es->elem[v] = piece_element(s, c, p);
+      es->elem[v] = e;
       es->flag[v] = 1;
     }
     for (fcm_index k = 0; k < n; k++, t++)
       for (int a = 0; a < 3; a++)
         es->tri[3 * t + a] = v - 3 * n + 3 * k + a;
   }
+  FCM_TRY(ctx, cache_cut_faces(es, v0, v - v0));
   es->np = np;
   es->nt = nt;
   es->num_split = nsplit;
 cleanup:
   if (st != FCM_OK) cache_clear(es);
-  /* the finder holds the cut cells' parts and the search trees: made per call (per cut); the
-   * cells' tree is the mesh's, which a new space keeps (fcm_embedded_surface_set_space()) */
-  fcm__embed_finder_destroy(&es->finder);
+  /* the finder's parts and cut triangles' tree are the rules': freed per call (per cut); what
+   * it holds for the mesh and geometry stays, as does the cells' tree (the mesh's, which a new
+   * space keeps: fcm_embedded_surface_set_space()) */
+  fcm__embed_finder_release(es->finder);
   fcm__free(ctx, split);
   fcm__free(ctx, changed);
   fcm__free(ctx, src);
@@ -748,6 +878,7 @@ cleanup:
   fcm__free(ctx, by_tri);
   fcm__free(ctx, first_x);
   fcm__free(ctx, ppiece);
+  fcm__free(ctx, xat);
   fcm__embed_polys_free(ctx, &polys);
   preclip_free(ctx, &pre);
   return st;
@@ -816,7 +947,9 @@ void fcm_embedded_surface_destroy(fcm_embedded_surface **surface)
   fcm__embed_finder_destroy(&es->finder);
   fcm_aabb_tree_destroy(&es->cell_tree);
   cache_clear(es);
-  void *arrays[] = {es->X, es->xi, es->cell, es->elem, es->tri, es->tri0, es->flag};
+  void *arrays[] = {es->X,       es->xi,    es->cell,     es->elem,   es->tri,
+                    es->tri0,    es->flag,  es->tc_first, es->tc_ids, es->tc_n,
+                    es->cf_cell, es->cf_xi, es->cf_X,     es->tarea};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(es->ctx, arrays[k]);
   fcm__free(es->ctx, es);
