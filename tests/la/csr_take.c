@@ -3,8 +3,8 @@
  * up to that size, and at least half of it, lands on the same storage, zero filled again, and
  * the giver is left without values; a larger or a much smaller matrix gets storage of its own
  * and the giver keeps its values. The context counts one allocation per array throughout. A
- * matrix made on no giver's storage has its room mapped at once (the next cut's matrix grows
- * into it without page faults): its last page is resident before anything writes it. */
+ * matrix's room mapped (fcm__csr_map_room(), for an integrator whose storage a cut takes): its
+ * last page is resident before anything writes it, and its values are kept. */
 #define _DEFAULT_SOURCE /* mincore */
 #include "la/la_impl.h"
 #include "test.h"
@@ -83,8 +83,14 @@ int main(void)
 
   /* 10 % larger: taken, zero again, the giver without values */
   fcm_csr *A = diagonal(NBIG, NULL);
+  fcm__csr_map_room(A);
   TEST_TRUE(room_resident(fcm_csr_values_read(A), NBIG));
-  check_values(A, NBIG);
+  check_values(A, NBIG); /* zero after the mapping, then 1 .. n */
+  fcm__csr_map_room(A);  /* once per array: the values stay */
+  int same = 1;
+  for (fcm_index i = 0; i < NBIG; i++)
+    same &= fcm_csr_values_read(A)[i] == (double)(i + 1);
+  TEST_TRUE(same);
   const double *va = fcm_csr_values_read(A);
   const fcm_index n1 = NBIG + NBIG / 10;
   fcm_csr *B = diagonal(n1, A);

@@ -4,10 +4,10 @@
  * A large array has a quarter more room than asked, address space only (never touched before
  * it is used), so that a slightly larger array of its successor (a cut's new matrix) can take
  * it over (fcm__calloc_large_from()): the first touch of fresh pages, huge ones above all,
- * costs several times the zero fill of pages already mapped. The arrays a successor takes
- * (fcm__calloc_large_mapped(), fcm__calloc_large_from()) have their room mapped when they are
- * created, so that a cut growing into it pays no page faults: a quarter more resident memory
- * for those arrays (only; the others' room stays address space). */
+ * costs several times the zero fill of pages already mapped. An owner whose arrays a successor
+ * will take (an integrator with FCM_CUT_REUSE_STORAGE) maps their room when it makes them
+ * (fcm__large_map()), so that a cut growing into it pays no page faults: a quarter more
+ * resident memory for those arrays only; every other array's room stays address space. */
 #define _DEFAULT_SOURCE /* madvise, MADV_HUGEPAGE */
 #include "core_impl.h"
 
@@ -27,29 +27,11 @@ enum { HUGE_PAGE = 2 << 20, SMALL_ALIGN = 64 };
 typedef struct {
   void *raw;
   size_t capacity;
+  size_t mapped; /* the room is mapped (fcm__large_map()) */
 } large_header;
 
-/* alloc_large()'s flags: fill the n elements with zeros (else left untouched); map the room
- * beyond them too (one write per small page: the pages fault in now, not at the first write
- * of the array's successor). */
-enum { LARGE_ZERO = 1, LARGE_MAP_ROOM = 2 };
-
-/* A write of zero to each 4 KiB page of [p, end) (an array's room, contents undefined). */
-static void map_pages(unsigned char *p, unsigned char *end)
-{
-  if (p >= end) return;
-  for (; p < end; p += 4096)
-    *p = 0;
-  end[-1] = 0; /* the last page, when the stride stepped over its start */
-}
-
-/* The array p (bytes asked for, capacity of room) as flags ask. */
-static void *fill(unsigned char *p, size_t bytes, size_t capacity, int flags)
-{
-  if (flags & LARGE_ZERO) memset(p, 0, bytes);
-  if (flags & LARGE_MAP_ROOM) map_pages(p + ((flags & LARGE_ZERO) ? bytes : 0), p + capacity);
-  return p;
-}
+/* alloc_large()'s flag: fill the n elements with zeros (else left untouched). */
+enum { LARGE_ZERO = 1 };
 
 /* fcm__calloc_large() and its variants (flags: LARGE_*). */
 static void *alloc_large(fcm_ctx *ctx, size_t n, size_t size, int flags)
@@ -73,14 +55,15 @@ static void *alloc_large(fcm_ctx *ctx, size_t n, size_t size, int flags)
   if (!raw) return NULL;
   const uintptr_t first = (uintptr_t)(raw + sizeof(large_header));
   unsigned char *p = raw + sizeof(large_header) + (size_t)((align - first % align) % align);
-  const large_header h = {raw, capacity};
+  const large_header h = {raw, capacity, 0};
   memcpy(p - sizeof h, &h, sizeof h);
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   /* Before the first touch (the zero fill below), so that the pages fault in as huge ones.
    * Advice only: refused (kernel without transparent huge pages), the array still works. */
   if (align == HUGE_PAGE) (void)madvise(p, capacity - capacity % HUGE_PAGE, MADV_HUGEPAGE);
 #endif
-  return fill(p, bytes, capacity, flags);
+  if (flags & LARGE_ZERO) memset(p, 0, bytes);
+  return p;
 }
 
 void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size)
@@ -93,9 +76,19 @@ void *fcm__malloc_large(fcm_ctx *ctx, size_t n, size_t size)
   return alloc_large(ctx, n, size, 0);
 }
 
-void *fcm__calloc_large_mapped(fcm_ctx *ctx, size_t n, size_t size)
+void fcm__large_map(void *p)
 {
-  return alloc_large(ctx, n, size, LARGE_ZERO | LARGE_MAP_ROOM);
+  if (!p) return;
+  large_header h;
+  memcpy(&h, (unsigned char *)p - sizeof h, sizeof h);
+  if (h.mapped || h.capacity == 0) return; /* once per array, whoever takes it later */
+  /* each page read and written back: its contents kept, the page faulted in now */
+  volatile unsigned char *q = p;
+  for (size_t o = 0; o < h.capacity; o += 4096)
+    q[o] = q[o];
+  q[h.capacity - 1] = q[h.capacity - 1]; /* the last page, when the stride stepped over it */
+  h.mapped = 1;
+  memcpy((unsigned char *)p - sizeof h, &h, sizeof h);
 }
 
 void *fcm__large_take(void **from, size_t n, size_t size)
@@ -113,7 +106,7 @@ void *fcm__large_take(void **from, size_t n, size_t size)
 void *fcm__calloc_large_from(fcm_ctx *ctx, void **from, size_t n, size_t size)
 {
   void *p = fcm__large_take(from, n, size);
-  if (!p) return fcm__calloc_large_mapped(ctx, n, size);
+  if (!p) return fcm__calloc_large(ctx, n, size);
   memset(p, 0, n * size);
   return p;
 }

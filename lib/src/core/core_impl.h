@@ -74,18 +74,19 @@ void *fcm__calloc_large(fcm_ctx *ctx, size_t n, size_t size);
  * they are read; pages never written are never touched (address space only). */
 void *fcm__malloc_large(fcm_ctx *ctx, size_t n, size_t size);
 
-/* As fcm__calloc_large for an array a successor takes over (fcm__large_take(),
- * fcm__calloc_large_from(): a cut's matrix values, element blocks): its room is mapped now
- * too (each page written once), so that the successor's growth into it pays no first touch of
- * fresh pages (several milliseconds per 2 MiB huge page on some virtual machines) during a
- * cut. Costs the room as resident memory: from FCM__LARGE_MIN on a quarter more than asked. */
-void *fcm__calloc_large_mapped(fcm_ctx *ctx, size_t n, size_t size);
+/* Maps every page of the room of p (an array of fcm__calloc_large / fcm__malloc_large, or
+ * NULL), its contents kept (each page read and written back once), so that the array's
+ * successor (fcm__large_take()) grows into it without the first touch of fresh pages during a
+ * cut (several milliseconds per 2 MiB huge page on some virtual machines). Costs the room as
+ * resident memory (from FCM__LARGE_MIN on a quarter more than asked). Once per array: an
+ * array mapped before (taken over since) returns at once. No other thread may use p
+ * meanwhile. */
+void fcm__large_map(void *p);
 
 /* As fcm__calloc_large, on the storage of *from (an array of fcm__calloc_large, or NULL) when
  * n elements fill at least half of its room (a large array's room is a quarter more than it
  * was asked for): *from is then set to NULL (its owner gives it up) and the array zero filled
- * again, on pages already mapped. Otherwise a new array of fcm__calloc_large_mapped() (its
- * own successor takes it), *from untouched. */
+ * again, on pages already mapped. Otherwise a new array, *from untouched. */
 void *fcm__calloc_large_from(fcm_ctx *ctx, void **from, size_t n, size_t size);
 
 /* *from (an array of fcm__calloc_large, or NULL) as an array of n elements, its contents as

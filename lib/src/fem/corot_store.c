@@ -24,9 +24,8 @@ void fcm__assembly_corot_free(fcm_assembly_workspace *ws)
 
 /* A new store, each element at its own slot, with a quarter more slots for the elements of
  * later cuts (fcm__assembly_corot_take()). A slot is read only once its element's matrix is
- * built there (have); the arrays are zero filled all the same, so that the free slots are
- * mapped now (resident: a quarter more than the elements'), not when a cut's new elements
- * first write them (the first touch of fresh pages, slow on some virtual machines). */
+ * built there (have), so the arrays are not zero filled: the slots no element uses are
+ * address space only (fcm__assembly_corot_map() maps them). */
 static fcm_status store_alloc(fcm_assembly_workspace *ws)
 {
   fcm_status st = FCM_OK;
@@ -35,8 +34,8 @@ static fcm_status store_alloc(fcm_assembly_workspace *ws)
   const fcm_index ne = s->num_elems;
   c->cb = 9 * (size_t)s->nn * (size_t)(s->nn + 1) / 2;
   c->cap = ne + ne / 4 + 1;
-  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)c->cap * c->cb, c->K);
-  FCM__ALLOC_WITH(fcm__calloc_large, ws->ctx, (size_t)c->cap * 3 * s->nn, c->G);
+  FCM__ALLOC_WITH(fcm__malloc_large, ws->ctx, (size_t)c->cap * c->cb, c->K);
+  FCM__ALLOC_WITH(fcm__malloc_large, ws->ctx, (size_t)c->cap * 3 * s->nn, c->G);
   FCM_ALLOC(ws->ctx, (size_t)ne + 1, c->have);
   FCM_ALLOC_RAW(ws->ctx, (size_t)ne + 1, c->slot);
   for (fcm_index e = 0; e < ne; e++)
@@ -205,6 +204,12 @@ void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_work
   if (!c->K || o->K || !o->have) return; /* old's store is its own (nothing taken) */
   o->K = c->K, o->G = c->G, c->K = NULL, c->G = NULL;
   memset(o->have, 0, (size_t)old->space->num_elems); /* its slots' matrices may be others' */
+}
+
+void fcm__assembly_corot_map(fcm_assembly_workspace *ws)
+{
+  fcm__large_map(ws->corot.K);
+  fcm__large_map(ws->corot.G);
 }
 
 fcm_index fcm__assembly_corot_built(const fcm_assembly_workspace *ws)

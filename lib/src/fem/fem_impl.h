@@ -532,6 +532,10 @@ fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_wor
  * next use, the same bits. Nothing taken: nothing done. (corot_store.c) */
 void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_workspace *old);
 
+/* The store's free slots mapped (fcm__large_map()): a later cut's new elements write them
+ * without the first touch of fresh pages. For a workspace whose store a cut will take. */
+void fcm__assembly_corot_map(fcm_assembly_workspace *ws);
+
 /* Element stiffness matrices of the corotated linear model that the hyperelastic assemblies
  * through ws have integrated since its creation (kept ones taken over a cut not counted).
  * (corot_store.c) */

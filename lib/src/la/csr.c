@@ -171,6 +171,11 @@ static double *values_from(fcm_ctx *ctx, fcm_csr *give, fcm_index nnz)
   return v;
 }
 
+void fcm__csr_map_room(fcm_csr *A)
+{
+  if (A && A->owned) fcm__large_map(A->values);
+}
+
 int fcm__csr_give_back(fcm_csr *from, fcm_csr *to)
 {
   if (!from || !to || !from->owned || !to->owned || !from->values || to->values) return 0;

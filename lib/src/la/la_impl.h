@@ -133,6 +133,10 @@ fcm_status fcm__csr_share_pattern_from(fcm_ctx *ctx, fcm_index nrows, fcm_index 
                                        const fcm_index *row_ptr, const int *col_idx,
                                        fcm_csr_kind kind, fcm_csr *give, fcm_csr **A);
 
+/* The room of A's values (when A owns them) mapped, its contents kept (fcm__large_map()): for
+ * a matrix whose storage a successor will take (fcm__csr_share_pattern_from()). */
+void fcm__csr_map_room(fcm_csr *A);
+
 /* The values storage `to` gave to `from` (fcm__csr_share_pattern_from()) back to `to`: 1 when
  * given back (to's values then as from's left them, from without values: destroy only); 0 when
  * there is nothing to give back (to has values, or from none of its own). (csr.c) */

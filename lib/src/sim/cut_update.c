@@ -100,10 +100,11 @@ fcm_status fcm__sim_assemble_kept(fcm_integrator *I, const fcm_linear_form *form
     }
     same = I->cut_self, old_blocks = *blocks;
   } else { /* below FCM__LARGE_MIN fcm__calloc_large() gives no room: a quarter more asked for,
-              so that the next cut's blocks fit in place (take_blocks()); the room mapped now,
-              not when the next cut writes it (fcm__calloc_large_mapped()) */
+              so that the next cut's blocks fit in place (take_blocks()); the room mapped now
+              where a cut will take them, not when it writes them */
     const size_t n = (size_t)ne * bs + 1, room = n * sizeof **blocks < FCM__LARGE_MIN ? n / 4 : 0;
-    FCM__ALLOC_WITH(fcm__calloc_large_mapped, ctx, n + room, *blocks);
+    FCM__ALLOC_WITH(fcm__calloc_large, ctx, n + room, *blocks);
+    if (I->opts.cut_reuse & FCM_CUT_REUSE_STORAGE) fcm__large_map(*blocks);
   }
   FCM_TRY(ctx, fcm__assembly_linear_blocks_rows(I->aws, form, A, f, same, old_blocks, *blocks,
                                                 I->cut_rows ? I->cut_dirty : NULL));

@@ -3,6 +3,7 @@
  * across a cut; the state and its queries are in state.c. */
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
+#include "la/la_impl.h"
 
 #include <math.h>
 #include <string.h>
@@ -489,6 +490,15 @@ cleanup:
   return st;
 }
 
+/* 1 when a cut will take I's storage (FCM_CUT_REUSE_STORAGE): the room of its large arrays
+ * (H's and M's values, the corotated store) is mapped as they are made, so that the cut
+ * growing into it pays no first touch of fresh pages; a quarter more resident memory for
+ * those arrays. */
+static int maps_room(const fcm_integrator *I)
+{
+  return (I->opts.cut_reuse & FCM_CUT_REUSE_STORAGE) != 0;
+}
+
 /* Set-up phase: the work vectors, the Newton matrix H and the assembly workspace. */
 static fcm_status setup_storage(fcm_integrator *I)
 {
@@ -506,6 +516,7 @@ static fcm_status setup_storage(fcm_integrator *I)
   else
     FCM_TRY(ctx, fcm__space_matrix_create_rows_unzeroed(
                      I->space, I->cut_give ? I->cut_give->H : NULL, &I->H));
+  if (maps_room(I)) fcm__csr_map_room(I->H);
   FCM_TRY(ctx, fcm_assembly_workspace_create(I->space, &I->opts.assembly, &I->aws));
   /* after a cut: the corotated linear model's element matrices the cut leaves valid (in the
    * old integrator's store, each kept element at its slot, when it gives its storage; else
@@ -526,6 +537,7 @@ static fcm_status setup_mass_and_loads(fcm_integrator *I)
   form.material = &I->mat; /* linear assembly: mass and body forces */
   if (I->opts.kind == FCM_INTEGRATOR_BACKWARD_EULER) {
     FCM_TRY(ctx, fcm__sim_cut_mass_matrix(I, &I->M)); /* after a cut: the kept rows taken */
+    if (maps_room(I)) fcm__csr_map_room(I->M);
     form.term = FCM_LINEAR_MASS;
     st = fcm__sim_assemble_kept(I, &form, I->M, NULL, &I->blk_mass,
                                 I->cut_old ? I->cut_old->blk_mass : NULL,
@@ -700,8 +712,10 @@ static fcm_status setup_values(fcm_integrator *I)
   FCM_TRY(ctx, setup_solvers(I));
   /* the corotated model's element stiffnesses (after a cut, those the cut made new): set-up
    * work, which the first step would do otherwise */
-  if (I->params.model == FCM_MATERIAL_COROTATED_LINEAR)
+  if (I->params.model == FCM_MATERIAL_COROTATED_LINEAR) {
     FCM_TRY(ctx, fcm__assembly_corot_build(I->aws, &I->params));
+    if (maps_room(I)) fcm__assembly_corot_map(I->aws);
+  }
   setup_initial_state(I);
   FCM_TRY(ctx, fcm__sim_contact_setup(I));
 cleanup:
