@@ -13,12 +13,15 @@
  * - the surface set to each cut space (the second reusing what the first cut found in the
  *   cells the second does not reach) has the bits of one made on that space anew: points,
  *   triangles, flags and the displacements of a field; so has the surface set back to it
- *   from a space of the same rules (every answer taken from what that rebuild kept).
+ *   from a space of the same rules (every answer taken from what that rebuild kept); so has
+ *   a surface whose rebuilds clip no (cell, triangle) pair ahead (each pair it splits is
+ *   clipped while the triangles are split).
  * The same for a box cut along cell faces through its boundary vertices, and for a box of 12
  * boundary triangles cut by the ball's planes (far more part points and cut faces than
  * boundary vertices: the surface's arrays grow, in its creation and at each cut).
  * Arguments: tet4 | tet10 | hex8 | hex20. */
 #include "fcm/fcm.h"
+#include "fem/fem_impl.h"
 #include "fem_util.h"
 
 #include <stdlib.h>
@@ -271,7 +274,7 @@ static void run(fcm_element_type type, fcm_geometry *g, int ncut, const double (
   fcm_cell_rules *r[3] = {NULL, NULL, NULL};
   fcm_space *s[3] = {NULL, NULL, NULL}, *free_space = NULL;
   fcm_surface *plane = NULL;
-  fcm_embedded_surface *es = NULL;
+  fcm_embedded_surface *es = NULL, *late = NULL;
   const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
   const fcm_index n3[3] = {4, 4, 4};
   const double h = 0.5;
@@ -283,7 +286,9 @@ static void run(fcm_element_type type, fcm_geometry *g, int ncut, const double (
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r[0]));
   TEST_OK(ctx, fcm_space_create_embedded(ctx, mesh, r[0], &s[0]));
   TEST_OK(ctx, fcm_embedded_surface_create(s[0], g, &es));
-  if (!es) goto done;
+  TEST_OK(ctx, fcm_embedded_surface_create(s[0], g, &late));
+  if (!es || !late) goto done;
+  late->test_no_preclip = 1;
   /* uncut: the geometry's triangles, nothing split */
   TEST_TRUE(fcm_embedded_surface_num_triangles(es) == fcm_geometry_num_boundary_triangles(g));
   TEST_TRUE(fcm_embedded_surface_num_split_triangles(es) == 0);
@@ -304,6 +309,8 @@ static void run(fcm_element_type type, fcm_geometry *g, int ncut, const double (
     if (!s[k + 1] || !free_space) goto done;
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, s[k + 1]));
     same_as_new(es, s[k + 1], g);
+    TEST_OK(ctx, fcm_embedded_surface_set_space(late, s[k + 1]));
+    same_as_new(late, s[k + 1], g);
     check(s[k + 1], es, g, k + 1, (const double(*)[3])at, pn, h, 0);
     TEST_OK(ctx, fcm_embedded_surface_set_space(es, free_space));
     check(free_space, es, g, k + 1, (const double(*)[3])at, pn, h, 1);
@@ -313,6 +320,7 @@ static void run(fcm_element_type type, fcm_geometry *g, int ncut, const double (
   }
 done:
   fcm_embedded_surface_destroy(&es);
+  fcm_embedded_surface_destroy(&late);
   fcm_space_destroy(&free_space);
   for (int k = 0; k < 3; k++) {
     fcm_space_destroy(&s[k]);

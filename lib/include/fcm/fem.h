@@ -551,6 +551,8 @@ FCM_API void fcm_embedded_surface_destroy(fcm_embedded_surface **surface);
  * new rules; the old space may be destroyed before): the element of every vertex is chosen
  * again, the triangles the cuts cross split again from the geometry's boundary (a later cut
  * splits the parts of earlier ones) and the cut faces rebuilt.
+ * After a failure the surface is unusable (some vertices' elements may be stale) until a
+ * later call succeeds: set it again or destroy it.
  * @return FCM_OK, FCM_ERR_ARG (NULL, other mesh), FCM_ERR_ALLOC, FCM_ERR_INTERNAL (a part
  * exceeding the clipping capacity). */
 FCM_API fcm_status fcm_embedded_surface_set_space(fcm_embedded_surface *surface,

@@ -435,7 +435,9 @@ fcm_status fcm__embed_finder_crosses(fcm__embed_finder *f, const double x[9], in
 
 /* Whether point x lies within w of a cut triangle of R: within w of its plane and inside its
  * three edge planes pushed out by w (0 without cuts). A point that parts of two pieces hold
- * (fcm__embed_finder_point() gives -2) lies on a cut triangle within the cuts' tolerance. */
+ * (fcm__embed_finder_point() gives -2) mostly lies on a cut triangle within the cuts'
+ * tolerance, but not always (two pieces of one cell may touch away from the cuts): a caller
+ * must not rely on it. */
 fcm_status fcm__embed_finder_near_cut(fcm__embed_finder *f, const double x[3], double w, int *near);
 
 /* Free what the finder holds for its rules (the cut triangles' tree, the current cell's parts

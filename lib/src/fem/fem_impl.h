@@ -589,6 +589,8 @@ struct fcm_embedded_surface {
    * and a millionth of the mesh's largest extent */
   fcm_aabb_tree *cell_tree;
   double cell_pad;
+  /* tests: the rebuild clips no pair ahead (split_triangles() clips every pair it splits) */
+  int test_no_preclip;
   /* What the last rebuild with cuts found, for the next one on rules that extend its rules
    * by further cuts (surface.c: cells no new cut triangle reaches keep their answers):
    * those rules' cut triangles (copied), pieces per cell (piece_off, num cells + 1), the

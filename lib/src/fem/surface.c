@@ -239,10 +239,12 @@ cleanup:
 }
 
 /* Polygons clipped ahead: those of the (cell, triangle) pairs pairs[0 .. n) (sorted), pair k's
- * polys.x from xoff[k], polygons off[k] .. off[k + 1] of polys. */
+ * polys.x from xoff[k], polygons off[k] .. off[k + 1] of polys; clipped[k]: whether pair k was
+ * clipped (a pair left out has no polygons here). */
 typedef struct preclip {
   fcm_index *pairs;
   size_t *off, *xoff, n;
+  unsigned char *clipped;
   fcm__embed_polys polys;
 } preclip;
 
@@ -251,6 +253,7 @@ static void preclip_free(fcm_ctx *ctx, preclip *pc)
   fcm__free(ctx, pc->pairs);
   fcm__free(ctx, pc->off);
   fcm__free(ctx, pc->xoff);
+  fcm__free(ctx, pc->clipped);
   fcm__embed_polys_free(ctx, &pc->polys);
   memset(pc, 0, sizeof *pc);
 }
@@ -281,7 +284,7 @@ static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, const fcm_ind
     for (int d = 0; d < 3; d++)
       lo[d] -= 1e-9 * w, hi[d] += 1e-9 * w;
     FCM_TRY(ctx, fcm__geom_tree_query(ctx, es->cell_tree, lo, hi, &q));
-    if (es->tc_len + q.n > es->tc_cap) {
+    if (!es->tc_ids || es->tc_len + q.n > es->tc_cap) {
       size_t cap = es->tc_cap ? 2 * es->tc_cap : 4096;
       while (cap < es->tc_len + q.n)
         cap *= 2;
@@ -290,7 +293,7 @@ static fcm_status tri_cells(fcm_embedded_surface *es, fcm_index t, const fcm_ind
       es->tc_ids = a;
       es->tc_cap = cap;
     }
-    memcpy(es->tc_ids + es->tc_len, q.ids, q.n * sizeof *q.ids);
+    if (q.n) memcpy(es->tc_ids + es->tc_len, q.ids, q.n * sizeof *q.ids);
     es->tc_first[t] = (fcm_index)es->tc_len;
     es->tc_n[t] = (int)q.n;
     es->tc_len += q.n;
@@ -333,6 +336,7 @@ static fcm_status preclip_pairs(fcm_embedded_surface *es, const unsigned char *c
   if (pc->n > 1) qsort(pc->pairs, pc->n, 2 * sizeof *pc->pairs, cmp_pair);
   FCM_ALLOC_RAW(ctx, pc->n + 1, pc->off);
   FCM_ALLOC_RAW(ctx, pc->n + 1, pc->xoff);
+  FCM_ALLOC(ctx, pc->n + 1, pc->clipped);
 cleanup:
   return st;
 }
@@ -340,8 +344,9 @@ cleanup:
 /* Clip the pairs of cell c from *k on (the finder holds c's parts), but those of triangles
  * known by now to stay whole: no cut crosses them (crosses) and each vertex is either known
  * off the cuts (on_cut, once looked up: a vertex in a cell up to c, or one whose answer is
- * kept; `lookup` flags the vertices looked up in this rebuild) or not near one (maybe). What
- * is left out here and split after all is clipped by split_triangles(). */
+ * kept; `lookup` flags the vertices looked up in this rebuild) or not near one (maybe). A pair
+ * left out here (pc->clipped[k] 0) whose triangle is split after all (a vertex found on a cut
+ * that was not near one) is clipped by split_triangles(). */
 static fcm_status preclip_cell(fcm_embedded_surface *es, fcm_index c, const unsigned char *crosses,
                                const unsigned char *maybe, const unsigned char *on_cut,
                                const unsigned char *lookup, preclip *pc, size_t *k)
@@ -354,10 +359,11 @@ static fcm_status preclip_cell(fcm_embedded_surface *es, fcm_index c, const unsi
     int may = crosses[t];
     for (int a = 0; a < 3 && !may; a++)
       may = lookup[v[a]] && es->cell[v[a]] > c ? maybe[v[a]] : on_cut[v[a]];
-    if (!may) continue;
+    if (!may || es->test_no_preclip) continue;
     double x[9];
     tri_coords(es, t, x);
     FCM_TRY(es->ctx, fcm__embed_finder_clip(es->finder, c, x, &pc->polys));
+    pc->clipped[*k] = 1;
   }
 cleanup:
   return st;
@@ -444,7 +450,9 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
       continue;
     }
     pairs[2 * n] = c, pairs[2 * n + 1] = i, n++;
-    int near = 0; /* a vertex on a cut lies on a cut triangle: the pad is far above its tolerance */
+    /* a vertex on a cut mostly lies on a cut triangle (the pad is far above its tolerance);
+     * the pairs of one that does not are clipped by split_triangles() */
+    int near = 0;
     FCM_TRY(ctx, fcm__embed_finder_near_cut(f, es->X + 3 * i, es->cell_pad, &near));
     maybe[i] = (unsigned char)near;
     lookup[i] = qcell[c] = 1;
@@ -532,7 +540,7 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
       for (size_t q = es->poff[j]; q < es->poff[j + 1]; first_x += (size_t)es->polys.nv[q++])
         FCM_TRY(ctx, polys_append(ctx, polys, &es->polys, q, first_x,
                                   map_piece(es, c, es->polys.piece[q])));
-    } else if (jp < pre->n && !cmp_pair(pre->pairs + 2 * jp, pairs + 2 * k)) {
+    } else if (jp < pre->n && pre->clipped[jp] && !cmp_pair(pre->pairs + 2 * jp, pairs + 2 * k)) {
       size_t first_x = pre->xoff[jp]; /* clipped while mark_split() had the cell's parts */
       for (size_t q = pre->off[jp]; q < pre->off[jp + 1]; first_x += (size_t)pre->polys.nv[q++])
         FCM_TRY(ctx, polys_append(ctx, polys, &pre->polys, q, first_x, pre->polys.piece[q]));
@@ -548,7 +556,7 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
       pxi = a;
       xcap = ncap;
     }
-    if (reused && es->pxi)
+    if (reused && es->pxi && polys->nx > xoff[k])
       memcpy(pxi + 3 * xoff[k], es->pxi + 3 * es->xoff[j], 3 * (polys->nx - xoff[k]) * sizeof *pxi);
     else
       for (size_t q = 3 * xoff[k]; q < 3 * polys->nx; q++)
