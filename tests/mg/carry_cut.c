@@ -9,8 +9,11 @@
  * FCM_ERR_ALLOC, leaks nothing and leaves the old hierarchy as it was (its cycles' bits). A
  * carry whose preconditions fail (the old hierarchy made on another space, or on a matrix
  * not of its space's pattern; the new matrix not of its space's pattern) takes nothing and
- * gives the plain hierarchy, without an error. The embedded hemisphere of mg_util.h, Hex8 and
- * Hex20, V- and W-cycles. */
+ * gives the plain hierarchy, without an error. Made beside (in a team of two, level 0's smoothers
+ * left to a task that the other thread may run, completed by fcm__mg_join() after the barrier)
+ * the carry is the same hierarchy, and its allocation failures, in either part, are reported
+ * (by the creation or the join) and leak nothing. The embedded hemisphere of mg_util.h, Hex8
+ * and Hex20, V- and W-cycles. */
 #include "fem/fem_impl.h"
 #include "mg/levels_impl.h"
 #include "mg_compare.h"
@@ -18,6 +21,7 @@
 #include "test_alloc.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 
 /* The space of `rules` made by a cut of `from` (its pattern taken), its clamped matrix. */
@@ -39,6 +43,38 @@ static void problem_drop(problem *p)
   fcm_space_destroy(&p->space);
   free(p->b);
   memset(p, 0, sizeof *p);
+}
+
+/* The carry made beside (fcm__mg_create_pattern_cut_beside()) by one thread of a team of two,
+ * the other free to run level 0's task, joined after the team's barrier: pending at the
+ * return wherever there is an old hierarchy (a team of two formed), complete after the join;
+ * the block smoothers' positions those of a plain creation on every level. */
+static fcm_mg *beside_carry(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *prev,
+                            const fcm_space *space, const fcm_csr *pattern,
+                            const unsigned char *inactive, const fcm_mg_options *o)
+{
+  fcm_mg *bes = NULL, *plain = NULL;
+  fcm_status sb = FCM_OK;
+  int pending = 0, team = 0;
+#pragma omp parallel num_threads(2)
+#pragma omp single
+  {
+    team = omp_get_num_threads();
+    sb = fcm__mg_create_pattern_cut_beside(ctx, old, prev, space, pattern, inactive, o, &bes);
+    pending = sb == FCM_OK && bes->beside != NULL;
+  }
+  TEST_OK(ctx, sb);
+  TEST_TRUE(pending == (old != NULL && team == 2));
+  double seconds = -1.0;
+  TEST_OK(ctx, fcm__mg_join(bes, &seconds));
+  TEST_TRUE(bes->beside == NULL && (pending ? seconds > 0.0 : seconds == 0.0));
+  TEST_OK(ctx, fcm__mg_join(bes, NULL)); /* a complete hierarchy: nothing to do */
+  TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, space, pattern, inactive, o, &plain));
+  TEST_TRUE(plain->nlev == bes->nlev && plain->blk_max == bes->blk_max);
+  for (int l = 0; l + 1 < bes->nlev && l + 1 < plain->nlev; l++)
+    TEST_TRUE(fcm__schwarz_same_positions(bes->lev[l].blk, plain->lev[l].blk));
+  fcm_mg_destroy(&plain);
+  return bes;
 }
 
 /* The hierarchy carried from old (NULL: none; on prev's space) to p's pattern, then set up,
@@ -80,9 +116,13 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
     }
     fcm_mg_destroy(&plain);
   }
+  fcm_mg *bes = beside_carry(ctx, old, prev, p->space, *pattern, inactive, o);
   memcpy(fcm_csr_values(*pattern), fcm_csr_values_read(p->A),
          sizeof(double) * (size_t)fcm_csr_row_ptr(p->A)[p->n]);
   TEST_OK(ctx, fcm_mg_setup(prep));
+  TEST_OK(ctx, fcm_mg_setup(bes));
+  TEST_TRUE(mgc_same(ctx, prep, bes, p->b, p->n, 2));
+  fcm_mg_destroy(&bes);
   TEST_OK(ctx, fcm_mg_create(ctx, p->space, p->A, o, &fresh));
   const int same = mgc_same(ctx, prep, fresh, p->b, p->n, 2);
   int exact = 1;
@@ -121,6 +161,65 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
   return prep;
 }
 
+/* failing_alloc() for allocations from several threads: the count taken atomically, so that
+ * exactly one allocation, whichever thread makes it, is the fail_at-th. */
+static void *team_failing_alloc(void *user, size_t size)
+{
+  failing *f = user;
+  long long k;
+#pragma omp atomic capture
+  k = f->count++;
+  if (f->fail_at >= 0 && k == f->fail_at) return NULL;
+  return malloc(size);
+}
+
+/* Allocations made to fail, spread over a carry made beside: level 0's task makes few of them,
+ * and its thread interleaves them with the coarser levels'. */
+enum { BESIDE_FAILURES = 60 };
+
+/* Carries made beside (a team of two, joined after its barrier) whose allocations fail at
+ * several places, in the coarser levels' part or in level 0's task: FCM_ERR_ALLOC from the
+ * creation or from the join, nothing leaked (the failed hierarchy destroyed). */
+static void failing_besides(const fcm_mg *old, const problem *cur, const problem *next,
+                            const fcm_mg_options *o, const unsigned char *inactive)
+{
+  failing fl = {0, -1};
+  fcm_ctx_options co = fcm_ctx_options_default();
+  co.allocator.alloc = team_failing_alloc;
+  co.allocator.release = failing_release;
+  co.allocator.user = &fl;
+  fcm_ctx *fctx = NULL;
+  TEST_OK(NULL, fcm_ctx_create(&co, &fctx));
+  fcm_mg *mg = NULL;
+  TEST_OK(fctx, fcm__mg_create_pattern_cut_beside(fctx, old, cur->space, next->space, next->A,
+                                                  inactive, o, &mg));
+  TEST_OK(fctx, fcm__mg_join(mg, NULL));
+  const long long total = fl.count;
+  fcm_mg_destroy(&mg);
+  const long long live = fcm_ctx_live_allocations(fctx);
+  int failures = 0, in_join = 0;
+  for (int q = 0; q < BESIDE_FAILURES; q++) {
+    fl.count = 0, fl.fail_at = q * total / BESIDE_FAILURES + 1;
+    fcm_status st = FCM_OK;
+#pragma omp parallel num_threads(2)
+#pragma omp single
+    st = fcm__mg_create_pattern_cut_beside(fctx, old, cur->space, next->space, next->A, inactive, o,
+                                           &mg);
+    if (st == FCM_OK) {
+      st = fcm__mg_join(mg, NULL);
+      in_join += st == FCM_ERR_ALLOC;
+      if (st != FCM_OK) fcm_mg_destroy(&mg);
+    }
+    fl.fail_at = -1;
+    failures += st == FCM_ERR_ALLOC && mg == NULL;
+    fcm_ctx_error_clear(fctx);
+    TEST_TRUE(fcm_ctx_live_allocations(fctx) == live);
+  }
+  TEST_TRUE(failures == BESIDE_FAILURES);
+  TEST_TRUE(in_join > 0); /* some failed in level 0's task, reported by the join */
+  fcm_ctx_destroy(&fctx);
+}
+
 /* Carries from old whose allocations fail at several places: FCM_ERR_ALLOC, nothing leaked,
  * old's cycles as before. */
 static void failing_carries(fcm_ctx *ctx, fcm_mg *old, const problem *cur, const problem *next,
@@ -151,6 +250,7 @@ static void failing_carries(fcm_ctx *ctx, fcm_mg *old, const problem *cur, const
     TEST_TRUE(fcm_ctx_live_allocations(fctx) == live);
   }
   TEST_TRUE(failures == 6);
+  failing_besides(old, cur, next, o, inactive);
   mgc_cycles(ctx, old, cur->b, cur->n, 2, x1);
   TEST_TRUE(memcmp(x0, x1, bytes) == 0);
   free(inactive);

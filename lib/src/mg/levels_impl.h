@@ -136,7 +136,10 @@ struct fcm_mg {
   /* the space whose pattern level 0's matrix had at creation (fcm__mg_pattern_of()), NULL
    * for none; kept by fcm__mg_detach(), only compared */
   const fcm_space *pattern_of;
-  mg_grid *mesh_grid; /* grid hierarchies: the mesh's grid (shared, fcm__mg_grid_release()) */
+  mg_grid *mesh_grid;       /* grid hierarchies: the mesh's grid (shared, fcm__mg_grid_release()) */
+  struct mg_beside *beside; /* level 0's smoothers still being made by a task of the team the
+                               creation ran in (fcm__mg_create_pattern_cut_beside()), NULL
+                               once fcm__mg_join() completed them */
 };
 
 /* Threads of a parallel region: the context's now, at most those of the creation (scratch). */
@@ -394,6 +397,15 @@ typedef struct mg_carry {
   unsigned char *copy_same; /* level 0, per copy: its three rows the old copy's mapped, column
                                for column in the same order (the copy graphs compared) */
 } mg_carry;
+
+/* Level 0's smoothers made beside the rest of a cut's creation (create_beside()): what their
+ * task reads and reports, the hierarchy's (m->beside) until fcm__mg_join(). */
+typedef struct mg_beside {
+  mg_carry carry; /* the cut's maps, which the coarser levels' patterns read too */
+  fcm__loop loop; /* iteration 0: the coarser levels; 1: level 0 (its error comes second) */
+  fcm_index bmax, carried;
+  double seconds; /* the task's wall time */
+} mg_beside;
 
 /* The space when A has the space's pattern (row_ptr and col_idx the space's arrays, shared,
  * or the same values: fcm_space_matrix_create()), else NULL. O(1) when shared, else one

@@ -47,6 +47,11 @@ void fcm_mg_destroy(fcm_mg **mg)
 {
   if (!mg || !*mg) return;
   fcm_mg *m = *mg;
+  if (m->beside) { /* level 0's task created by this thread waited for, then dropped */
+#pragma omp taskwait
+    fcm__mg_carry_free(m->ctx, &m->beside->carry);
+    fcm__free(m->ctx, m->beside);
+  }
   for (int l = 0; l < MG_MAX_LEVELS; l++)
     fcm__mg_level_free(m->ctx, &m->lev[l]);
   fcm_direct_destroy(&m->direct);
@@ -332,35 +337,62 @@ cleanup:
  * the values pending): level 0's smoothing order and block smoother read only level 0's
  * pattern and diagonal, its grid and the carry's maps, and write level 0's own fields, so
  * they are made as a task beside the coarser levels' patterns, orders and smoothers and the
- * coarsest analysis: a thread of the team the cut runs on takes it when it is free
- * (scene/run.c cut_parts()), else this thread runs it, before or after the rest (outside a
- * team at once). The same bits either way; an error is the coarser levels' before level 0's. */
-static fcm_status create_beside(fcm_mg *m, mg_carry *carry, unsigned char *same)
+ * coarsest analysis. A thread of the team the cut runs on takes it when it is free
+ * (scene/run.c cut_parts()). With `defer` inside an active parallel region this thread
+ * returns once its own part is done, leaving the task to whichever thread gets to it first
+ * and its completion to fcm__mg_join() after the team's barrier (the maps move into the
+ * hierarchy, since the task may outlive this frame); otherwise this thread waits for the task
+ * or runs it. The same bits either way; an error is the coarser levels' before level 0's. */
+static fcm_status create_beside(fcm_mg *m, mg_carry *carry, unsigned char *same, int defer)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
-  fcm__loop L;
-  fcm_index bmax = 0, carried = 0;
-  fcm__loop_begin(ctx, &L);
-#pragma omp task default(shared)
+  mg_beside *b = fcm__calloc(ctx, 1, sizeof *b);
+  FCM_CHECK(b, ctx, FCM_ERR_ALLOC, "mg_create: out of memory");
+  b->carry = *carry;
+  memset(carry, 0, sizeof *carry);
+  m->beside = b;
+  fcm__loop_begin(ctx, &b->loop);
+#pragma omp task default(none) firstprivate(m, b)
   {
+    const double t0 = fcm_wtime();
     fcm__loop_iter it;
-    fcm__loop_enter(&L, &it, 1);
-    fcm__loop_leave(&L, &it, level0_smoothers(m, carry, &bmax, &carried));
+    fcm__loop_enter(&b->loop, &it, 1);
+    fcm__loop_leave(&b->loop, &it, level0_smoothers(m, &b->carry, &b->bmax, &b->carried));
+    b->seconds = fcm_wtime() - t0;
   }
   {
     fcm__loop_iter it;
-    fcm__loop_enter(&L, &it, 0);
-    fcm_status s = create_patterns(m, NULL, carry, same, 1);
+    fcm__loop_enter(&b->loop, &it, 0);
+    fcm_status s = create_patterns(m, NULL, &b->carry, same, 1);
     if (s == FCM_OK && m->opts.block_smoothing)
-      s = fcm__mg_block_smoothers_create(m, NULL, same, carry, 1);
-    fcm__loop_leave(&L, &it, s);
+      s = fcm__mg_block_smoothers_create(m, NULL, same, &b->carry, 1);
+    fcm__loop_leave(&b->loop, &it, s);
+    if (s == FCM_OK && defer && omp_in_parallel()) return FCM_OK;
   }
 #pragma omp taskwait
-  FCM_TRY(ctx, fcm__loop_end(&L, NULL));
-  m->blk_max = FCM_MAX(m->blk_max, bmax);
-  m->kept.carried_blocks += carried;
+  FCM_TRY(ctx, fcm__mg_join(m, NULL));
 cleanup:
+  return st;
+}
+
+fcm_status fcm__mg_join(fcm_mg *m, double *seconds)
+{
+  fcm_status st = FCM_OK;
+  if (seconds) *seconds = 0.0;
+  if (!m || !m->beside) return FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  mg_beside *b = m->beside;
+  m->beside = NULL;
+  if (seconds) *seconds = b->seconds;
+  st = fcm__loop_end(&b->loop, NULL);
+  if (st == FCM_OK) {
+    m->blk_max = FCM_MAX(m->blk_max, b->bmax);
+    m->kept.carried_blocks += b->carried;
+    if (m->opts.block_smoothing) st = fcm__mg_block_buffers(m);
+  }
+  fcm__mg_carry_free(ctx, &b->carry);
+  fcm__free(ctx, b);
   return st;
 }
 
@@ -369,7 +401,7 @@ cleanup:
  * the values left to fcm_mg_setup(). */
 static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fcm_space *space,
                             const fcm_csr *A, const unsigned char *inactive,
-                            const fcm_mg_options *opts, fcm_mg **mg)
+                            const fcm_mg_options *opts, int defer, fcm_mg **mg)
 {
   fcm_status st = FCM_OK;
   fcm_mg *m = NULL;
@@ -399,14 +431,15 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
   if (carry && carry->old) FCM_TRY(ctx, fcm__mg_carry_maps(m, carry));
   if (carry && carry->old && !old && m->values_pending && m->nlev > 1) {
-    FCM_TRY(ctx, create_beside(m, carry, same));
+    FCM_TRY(ctx, create_beside(m, carry, same, defer)); /* joined: the buffers too */
   } else {
     FCM_TRY(ctx, create_patterns(m, old, carry, same, 0));
     if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));
-    if (o.block_smoothing) /* set up as created, or by the fcm_mg_setup() to come */
+    if (o.block_smoothing) { /* set up as created, or by the fcm_mg_setup() to come */
       FCM_TRY(ctx, fcm__mg_block_smoothers_create(m, old, same, carry, 0));
+      FCM_TRY(ctx, fcm__mg_block_buffers(m));
+    }
   }
-  if (o.block_smoothing) FCM_TRY(ctx, fcm__mg_block_buffers(m));
   *mg = m;
   m = NULL;
 cleanup:
@@ -417,13 +450,13 @@ cleanup:
 fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
                          const fcm_mg_options *opts, fcm_mg **mg)
 {
-  return mg_create(ctx, NULL, NULL, space, A, NULL, opts, mg);
+  return mg_create(ctx, NULL, NULL, space, A, NULL, opts, 0, mg);
 }
 
 fcm_status fcm__mg_create_from(fcm_ctx *ctx, fcm_mg **old, const fcm_space *space, const fcm_csr *A,
                                const fcm_mg_options *opts, fcm_mg **mg)
 {
-  const fcm_status st = mg_create(ctx, old ? *old : NULL, NULL, space, A, NULL, opts, mg);
+  const fcm_status st = mg_create(ctx, old ? *old : NULL, NULL, space, A, NULL, opts, 0, mg);
   if (old) fcm_mg_destroy(old);
   return st;
 }
@@ -439,16 +472,16 @@ fcm_status fcm__mg_create_pattern(fcm_ctx *ctx, fcm_mg **old, const fcm_space *s
   FCM_CHECK(fcm_mesh_num_hanging(fcm_space_mesh(space)) == 0, ctx, FCM_ERR_UNSUPPORTED,
             "mg_create_pattern: an octree mesh's hierarchy needs the matrix values (use "
             "fcm_mg_create())");
-  st = mg_create(ctx, old ? *old : NULL, NULL, space, A, inactive, opts, mg);
+  st = mg_create(ctx, old ? *old : NULL, NULL, space, A, inactive, opts, 0, mg);
 cleanup:
   if (old) fcm_mg_destroy(old);
   return st;
 }
 
-fcm_status fcm__mg_create_pattern_cut(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *old_space,
-                                      const fcm_space *space, const fcm_csr *A,
-                                      const unsigned char *inactive, const fcm_mg_options *opts,
-                                      fcm_mg **mg)
+static fcm_status create_pattern_cut(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *old_space,
+                                     const fcm_space *space, const fcm_csr *A,
+                                     const unsigned char *inactive, const fcm_mg_options *opts,
+                                     int defer, fcm_mg **mg)
 {
   fcm_status st = FCM_OK;
   mg_carry carry;
@@ -460,10 +493,26 @@ fcm_status fcm__mg_create_pattern_cut(fcm_ctx *ctx, const fcm_mg *old, const fcm
             "mg_create_pattern_cut: an octree mesh's hierarchy needs the matrix values (use "
             "fcm_mg_create())");
   carry.old = old, carry.old_space = old_space;
-  st = mg_create(ctx, NULL, &carry, space, A, inactive, opts, mg);
+  st = mg_create(ctx, NULL, &carry, space, A, inactive, opts, defer, mg);
 cleanup:
-  fcm__mg_carry_free(ctx, &carry);
+  fcm__mg_carry_free(ctx, &carry); /* what the hierarchy did not take (create_beside()) */
   return st;
+}
+
+fcm_status fcm__mg_create_pattern_cut(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *old_space,
+                                      const fcm_space *space, const fcm_csr *A,
+                                      const unsigned char *inactive, const fcm_mg_options *opts,
+                                      fcm_mg **mg)
+{
+  return create_pattern_cut(ctx, old, old_space, space, A, inactive, opts, 0, mg);
+}
+
+fcm_status fcm__mg_create_pattern_cut_beside(fcm_ctx *ctx, const fcm_mg *old,
+                                             const fcm_space *old_space, const fcm_space *space,
+                                             const fcm_csr *A, const unsigned char *inactive,
+                                             const fcm_mg_options *opts, fcm_mg **mg)
+{
+  return create_pattern_cut(ctx, old, old_space, space, A, inactive, opts, 1, mg);
 }
 
 /* Level l's block smoother on its matrix's values: after a set-up of this hierarchy (or its

@@ -128,6 +128,25 @@ FCM_COMPONENT_API fcm_status fcm__mg_create_pattern_cut(fcm_ctx *ctx, const fcm_
                                                         const unsigned char *inactive,
                                                         const fcm_mg_options *opts, fcm_mg **mg);
 
+/* fcm__mg_create_pattern_cut() inside a parallel region whose barrier comes before m is used
+ * (scene/run.c cut_parts()): level 0's smoothing order and block smoother are made by a task
+ * that any thread of the team may run, and may still be pending when this returns FCM_OK, so
+ * that the calling thread goes on with other work. Until fcm__mg_join(), after the team's
+ * barrier, m must not be used (fcm_mg_destroy() is allowed: it waits for the task when called
+ * by the thread that created it, which the barrier makes moot), and old, old_space, space
+ * and A's pattern must live. Outside an active parallel region the task runs at once. The
+ * result after fcm__mg_join() is fcm__mg_create_pattern_cut()'s bit for bit. */
+FCM_COMPONENT_API fcm_status fcm__mg_create_pattern_cut_beside(
+    fcm_ctx *ctx, const fcm_mg *old, const fcm_space *old_space, const fcm_space *space,
+    const fcm_csr *A, const unsigned char *inactive, const fcm_mg_options *opts, fcm_mg **mg);
+
+/* Complete the creation of m (fcm__mg_create_pattern_cut_beside()) once the task making level
+ * 0's smoothers has run (after the team's barrier): its error (FCM_ERR_ALLOC, FCM_ERR_INTERNAL,
+ * with its message), or FCM_OK with m ready for fcm_mg_setup(); after an error m must be
+ * destroyed. *seconds (may be NULL): the task's wall time (0 when nothing was pending).
+ * Accepts NULL and a complete m (FCM_OK, nothing done). */
+FCM_COMPONENT_API fcm_status fcm__mg_join(fcm_mg *m, double *seconds);
+
 /* Forget the level-0 matrix and the space of m (they may be destroyed now): m stays usable
  * only as the `old` of fcm__mg_create_from(), which then keeps nothing of level 0 itself
  * (its plan needs level 0's pattern). Accepts NULL. */

@@ -268,6 +268,50 @@ cleanup:
   return st;
 }
 
+/* block_slabs()'s row reach of rows i0 .. i1 - 1 (last: per row the last block position
+ * holding it, -1: none): the last block position a row's columns reach, once per row of a
+ * block; the three rows of a node of one pattern (the row order's flags) read once, by the
+ * first of them, whichever range holds the other two. */
+static void rows_reach(const mg_level *L, const fcm_index *last, fcm_index i0, fcm_index i1,
+                       fcm_index *row_reach)
+{
+  const fcm_csr *A = fcm__mg_level_matrix(L);
+  const fcm_index *rp = fcm_csr_row_ptr(A), n = L->n;
+  const int *ci = fcm_csr_col_idx(A);
+  const unsigned char *tri = L->rows.triple;
+  for (fcm_index i = i0; i < i1; i++) {
+    const int three = fcm__mg_is_triple(tri, i - i % 3, n);
+    if (three && i % 3 != 0) continue; /* written with row i - i % 3 */
+    const int rows = three ? 3 : 1;
+    fcm_index r = -1;
+    if (last[i] >= 0 || (three && (last[i + 1] >= 0 || last[i + 2] >= 0)))
+      for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
+        r = FCM_MAX(r, last[ci[p]]);
+    for (int c = 0; c < rows; c++)
+      row_reach[i + c] = last[i + c] >= 0 ? r : -1;
+  }
+}
+
+/* block_slabs()'s reach and work of block positions t0 .. t1 - 1 (seq: the blocks in order). */
+static void blocks_reach(const mg_level *L, const fcm_index *seq, const fcm_index *row_reach,
+                         fcm_index t0, fcm_index t1, fcm_index *reach, double *work)
+{
+  const fcm_index *rp = fcm_csr_row_ptr(fcm__mg_level_matrix(L));
+  for (fcm_index t = t0; t < t1; t++) {
+    const fcm_index *d = NULL;
+    const double *S = NULL;
+    const fcm_index k = seq[t];
+    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
+    fcm_index r = t, entries = 0;
+    for (int i = 0; i < bm; i++) {
+      entries += rp[d[i] + 1] - rp[d[i]];
+      r = FCM_MAX(r, row_reach[d[i]]);
+    }
+    reach[t] = r;
+    work[k] = (double)entries + (double)bm * (double)bm;
+  }
+}
+
 /* The blocks of a level's block smoother in slabs, in the sequence of their first DOFs (ties
  * by index), so that it follows the rows. Blocks j and k are adjacent when a DOF of one couples
  * with (or is) a DOF of the other, i.e. when one's update reads what the other writes; work:
@@ -276,9 +320,6 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = m->ctx;
-  const fcm_csr *A = fcm__mg_level_matrix(L);
-  const fcm_index *rp = fcm_csr_row_ptr(A);
-  const int *ci = fcm_csr_col_idx(A);
   const fcm_index nb = fcm__schwarz_num_blocks(L->blk), n = L->n;
   fcm_index *first = NULL, *seq = NULL, *last = NULL, *reach = NULL, *row_reach = NULL;
   double *work = NULL;
@@ -315,32 +356,24 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
    * overlap: a cut cell's row lies in up to nine of them); the three rows of a node of one
    * pattern (the row order's flags) read once */
   FCM_ALLOC_RAW(ctx, n + 1, row_reach);
-  const unsigned char *tri = L->rows.triple;
-#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > 4096)
-  for (fcm_index i = 0; i < n; i++) {
-    const int three = fcm__mg_is_triple(tri, i - i % 3, n);
-    if (three && i % 3 != 0) continue; /* written with row i - i % 3 */
-    const int rows = three ? 3 : 1;
-    fcm_index r = -1;
-    if (last[i] >= 0 || (three && (last[i + 1] >= 0 || last[i + 2] >= 0)))
-      for (fcm_index p = rp[i]; p < rp[i + 1]; p++)
-        r = FCM_MAX(r, last[ci[p]]);
-    for (int c = 0; c < rows; c++)
-      row_reach[i + c] = last[i + c] >= 0 ? r : -1;
-  }
+  if (omp_in_parallel() && omp_get_num_threads() > 1) {
+    /* from a task of an active team (a cut's structure made beside other work, mg.c
+     * create_beside()): in tasks that any thread of the team takes when it is free */
+    const fcm_index nch = 8 * (fcm_index)omp_get_num_threads();
+#pragma omp taskloop default(shared) grainsize(1)
+    for (fcm_index c = 0; c < nch; c++)
+      rows_reach(L, last, n * c / nch, n * (c + 1) / nch, row_reach);
+#pragma omp taskloop default(shared) grainsize(1)
+    for (fcm_index c = 0; c < nch; c++)
+      blocks_reach(L, seq, row_reach, nb * c / nch, nb * (c + 1) / nch, reach, work);
+  } else {
+    const fcm_index chunk = 4096;
+#pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > chunk)
+    for (fcm_index i0 = 0; i0 < n; i0 += chunk)
+      rows_reach(L, last, i0, FCM_MIN(n, i0 + chunk), row_reach);
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (nb > 1024)
-  for (fcm_index t = 0; t < nb; t++) {
-    const fcm_index *d = NULL;
-    const double *S = NULL;
-    const fcm_index k = seq[t];
-    const int bm = fcm__schwarz_block(L->blk, k, &d, &S);
-    fcm_index r = t, entries = 0;
-    for (int i = 0; i < bm; i++) {
-      entries += rp[d[i] + 1] - rp[d[i]];
-      r = FCM_MAX(r, row_reach[d[i]]);
-    }
-    reach[t] = r;
-    work[k] = (double)entries + (double)bm * (double)bm;
+    for (fcm_index t = 0; t < nb; t++)
+      blocks_reach(L, seq, row_reach, t, t + 1, reach, work);
   }
   FCM_TRY(ctx, slabs_create(ctx, nb, seq, reach, work, 0, &L->blocks));
 cleanup:

@@ -473,10 +473,12 @@ static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space 
  * log's blocks the two spaces' elements and mass caches, which only they write), and each
  * gives the bits it gives alone (the loops inside run on one thread then, and give the bits
  * they give on two). A distributed run makes them on the calling thread in turn. A failed
- * part gives the storage back to the old integrator, which goes on. seconds[1]: the solver's
- * structure (the structure part's wall time, and the direct solver's symbolic analysis, which
- * the values make), seconds[0]: the rest of the integrator's; side by side each its own, so
- * they may add up to more than the cut. */
+ * part gives the storage back to the old integrator, which goes on. The structure leaves
+ * level 0's smoothers to a task (fcm__integrator_cut's `beside`): the thread that is free
+ * first runs it, before or after the parts left, and the end completes it after the
+ * barrier. seconds[1]: the solver's structure (the structure part's wall time, its task's,
+ * and the direct solver's symbolic analysis, which the values make), seconds[0]: the rest of
+ * the integrator's; side by side each its own, so they may add up to more than the cut. */
 static fcm_status cut_parts(fcm_simulation *S, const fcm_space *space, fcm_integrator **integ,
                             double *seconds)
 {
@@ -492,6 +494,7 @@ static fcm_status cut_parts(fcm_simulation *S, const fcm_space *space, fcm_integ
     /* side by side when a second long part goes beside the values: the structure or the
      * surface (the log's blocks alone would leave the values' loops one thread for little) */
     const int two = two_threads && (S->surf || fcm__integrator_cut_has_structure(&cut));
+    cut.beside = two; /* the structure may leave level 0's smoothers to the free thread */
     fcm__loop_begin(ctx, &L);
 #pragma omp parallel num_threads(2) if (two)
     {

@@ -820,7 +820,7 @@ cleanup:
 fcm_status fcm__integrator_cut_structure(fcm__integrator_cut *cut)
 {
   const double t0 = fcm_wtime();
-  const fcm_status st = fcm__sim_prepare_solver_cut(cut->integ, cut->old, &cut->con);
+  const fcm_status st = fcm__sim_prepare_solver_cut(cut->integ, cut->old, cut->beside, &cut->con);
   cut->seconds[1] += fcm_wtime() - t0;
   return st;
 }
@@ -836,6 +836,12 @@ fcm_status fcm__integrator_cut_end(fcm__integrator_cut *cut, fcm_status st, fcm_
   fcm_ctx *ctx = cut->old ? cut->old->ctx : NULL;
   const double t0 = fcm_wtime();
   *integ = NULL;
+  if (I && st == FCM_OK) { /* the structure's task that ran beside (done: past the barrier;
+                              after a failure the integrator's destruction drops it) */
+    double task = 0.0;
+    st = fcm__sim_join_solver(I, &task);
+    cut->seconds[1] += task;
+  }
   if (st == FCM_OK) {
     /* the structure's active set is I's when I's state holds it (always, by
      * fcm__sim_eval_constraints()); else the first factor builds the hierarchy again */

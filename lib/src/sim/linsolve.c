@@ -367,7 +367,7 @@ int fcm__sim_structure_wanted(const fcm_integrator *I)
  * what the setup's first stage wrote (options, backend, hanging DOFs, H's pattern) and its
  * hierarchy's fields, which it alone writes. */
 static fcm_status mg_structure(fcm_integrator *I, const fcm_integrator *from,
-                               const unsigned char *con, long long version)
+                               const unsigned char *con, long long version, int beside)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = I->ctx;
@@ -381,7 +381,10 @@ static fcm_status mg_structure(fcm_integrator *I, const fcm_integrator *from,
   predicted_eliminated(I, con, inactive);
   /* a cut's: old's hierarchy, made on its Newton matrix (the space's pattern), read */
   const fcm_mg *carry = from && from->mg && from->mg_A == from->H ? from->mg : NULL;
-  if (carry && !old)
+  if (carry && !old && beside)
+    st = fcm__mg_create_pattern_cut_beside(ctx, carry, from->space, I->space, I->H, inactive,
+                                           &I->opts.multigrid, &I->mg);
+  else if (carry && !old)
     st = fcm__mg_create_pattern_cut(ctx, carry, from->space, I->space, I->H, inactive,
                                     &I->opts.multigrid, &I->mg);
   else
@@ -410,7 +413,7 @@ static fcm_status prepare_solver(fcm_integrator *I, const fcm_integrator *from)
   FCM_CHECK(I->is_setup, I->ctx, FCM_ERR_ARG,
             "integrator prepare_solver: the integrator must be set up (fcm_integrator_setup())");
   const double t0 = fcm_wtime();
-  st = mg_structure(I, from, I->is_con, I->con_version);
+  st = mg_structure(I, from, I->is_con, I->con_version, 0);
   I->setup_info.solver_seconds += fcm_wtime() - t0;
 cleanup:
   return st;
@@ -421,7 +424,7 @@ fcm_status fcm_integrator_prepare_solver(fcm_integrator *I)
   return prepare_solver(I, NULL);
 }
 
-fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old,
+fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old, int beside,
                                        unsigned char **con)
 {
   fcm_status st = FCM_OK;
@@ -433,8 +436,18 @@ fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *
   FCM_ALLOC(ctx, (size_t)I->n + 1, *con);
   for (fcm_index i = 0; i < I->ncon; i++)
     (*con)[I->con_dof[i]] = (unsigned char)fcm_motion_active(&I->cons[I->con_id[i]].motion, old->t);
-  FCM_TRY(ctx, mg_structure(I, old, *con, -1));
+  FCM_TRY(ctx, mg_structure(I, old, *con, -1, beside));
 cleanup:
+  return st;
+}
+
+fcm_status fcm__sim_join_solver(fcm_integrator *I, double *seconds)
+{
+  const fcm_status st = fcm__mg_join(I->mg, seconds);
+  if (st != FCM_OK) {
+    fcm__error_prefix(I->ctx, "integrator: linear_solver multigrid");
+    fcm__trace(I->ctx, __FILE__, __LINE__, __func__);
+  }
   return st;
 }
 

@@ -59,13 +59,18 @@ fcm_status fcm__integrator_finish(fcm_integrator *I, fcm_status st);
  * fcm__sim_prepare_solver_cut(): it reads of the new integrator only what the first stage
  * wrote, the values job none of what it writes); fcm__integrator_cut_end() last, always. Each
  * stage's loops give the bits they give on any thread count; the result is
- * fcm_integrator_create_cut()'s bit for bit. */
+ * fcm_integrator_create_cut()'s bit for bit. With `beside` set (the stages run as parts of one
+ * parallel region, whose barrier comes before fcm__integrator_cut_end()) the structure job
+ * may return with a task of its own pending (fcm__mg_create_pattern_cut_beside()), which a
+ * thread of the team runs when it is free, and which the end completes. */
 typedef struct fcm__integrator_cut {
   const fcm_integrator *old;
   fcm_integrator *integ; /* the new integrator (NULL: not created) */
   fcm_integrator *giver; /* old when it gives its storage (FCM_CUT_REUSE_STORAGE) */
   unsigned char *con;    /* the structure's constrained DOFs (NULL: no structure) */
-  double seconds[2];     /* wall seconds: [0] begin, values and end, [1] the structure */
+  double seconds[2];     /* wall seconds: [0] begin, values and end, [1] the structure (its
+                            task's too when it runs beside) */
+  int beside;            /* the caller's: the structure job may leave a task to the team */
 } fcm__integrator_cut;
 
 /* The first stage into *cut (set whatever happens; fcm__integrator_cut_end() must follow). */

@@ -352,9 +352,16 @@ int fcm__sim_structure_wanted(const fcm_integrator *I);
  * may run side by side: the active set is that of old's time (the state the cut transfers),
  * computed here into *con (n entries, the caller's to free; NULL: no structure to prepare),
  * and I->mg_con is left -1 for the caller to set once I's active set is known to be *con.
+ * With `beside` (inside a parallel region) level 0's smoothers may be left to a task of the
+ * team: fcm__sim_join_solver() after the region's barrier completes them.
  * Adds nothing to I->setup_info.solver_seconds. (linsolve.c) */
-fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old,
+fcm_status fcm__sim_prepare_solver_cut(fcm_integrator *I, const fcm_integrator *old, int beside,
                                        unsigned char **con);
+
+/* After fcm__sim_prepare_solver_cut() with `beside`, once the team's barrier is passed: the
+ * hierarchy's creation completed (fcm__mg_join()); its error, with the solver's prefix.
+ * *seconds: the wall time of the task that ran beside (0: none). (linsolve.c) */
+fcm_status fcm__sim_join_solver(fcm_integrator *I, double *seconds);
 
 /* External load at time t: sum_k scale_k(t) f_k into f (n). (integrator.c) */
 void fcm__sim_eval_loads(const fcm_integrator *I, double t, double *f);

@@ -143,8 +143,32 @@ static fcm_index old_block(const fcm_schwarz *P, const fcm__schwarz_prior *pr,
   return -1;
 }
 
+/* Blocks b0 .. b1 - 1 of fcm__schwarz_positions_from() (loc: the running thread's DOF map):
+ * copied where old_block() finds their old block, else scanned; the number copied. */
+static fcm_index positions_range(fcm_schwarz *P, const fcm_csr *C, const unsigned char *tri,
+                                 const fcm__schwarz_prior *pr, const fcm_index *optr,
+                                 const fcm_index *oblk, fcm_index b0, fcm_index b1, int *loc)
+{
+  fcm_index carried = 0;
+  for (fcm_index b = b0; b < b1; b++) {
+    const fcm_index ob = old_block(P, pr, optr, oblk, b);
+    const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
+    if (ob >= 0) {
+      memcpy(P->pos + P->pos_off[b], pr->old->pos + pr->old->pos_off[ob],
+             sizeof *P->pos * FCM__SCHWARZ_PACKED(m, 0));
+      P->full[b] = pr->old->full[ob];
+      carried++;
+    } else {
+      scan_pattern(C, tri, m, P->dofs + P->block_ptr[b], loc, P->pos + P->pos_off[b], &P->full[b]);
+    }
+  }
+  return carried;
+}
+
 /* fcm__schwarz_scan_positions(), the positions of the blocks that are old blocks mapped
- * (old_block()) copied from them. */
+ * (old_block()) copied from them. Called from a task of an active team (a cut's structure
+ * made beside other work: mg/mg.c create_beside()), the blocks go in tasks that any thread of
+ * the team takes when it is free; else in a parallel loop of the creation's threads. */
 fcm_status fcm__schwarz_positions_from(fcm_schwarz *P, const fcm_csr *C, const unsigned char *tri,
                                        const fcm__schwarz_prior *pr)
 {
@@ -153,23 +177,24 @@ fcm_status fcm__schwarz_positions_from(fcm_schwarz *P, const fcm_csr *C, const u
   fcm_index *optr = NULL, *oblk = NULL, carried = 0;
   const fcm_index nb = P->num_blocks;
   FCM_TRY(ctx, old_by_first(ctx, pr->old, &optr, &oblk));
+  if (omp_in_parallel() && omp_get_num_threads() <= P->nt && nb > SCAN_PARALLEL_BLOCKS) {
+    const fcm_index nch = 8 * (fcm_index)omp_get_num_threads();
+#pragma omp taskloop default(shared) grainsize(1)
+    for (fcm_index c = 0; c < nch; c++) {
+      const fcm_index k =
+          positions_range(P, C, tri, pr, optr, oblk, nb * c / nch, nb * (c + 1) / nch,
+                          P->loc + (size_t)P->n * (size_t)omp_get_thread_num());
+#pragma omp atomic
+      carried += k;
+    }
+  } else {
 #pragma omp parallel num_threads(P->nt) if (P->nt > 1 && nb > SCAN_PARALLEL_BLOCKS) \
     reduction(+ : carried)
-  {
-    int *loc = P->loc + (size_t)P->n * (size_t)omp_get_thread_num();
+    {
+      int *loc = P->loc + (size_t)P->n * (size_t)omp_get_thread_num();
 #pragma omp for schedule(dynamic, 64)
-    for (fcm_index b = 0; b < nb; b++) {
-      const fcm_index ob = old_block(P, pr, optr, oblk, b);
-      const int m = (int)(P->block_ptr[b + 1] - P->block_ptr[b]);
-      if (ob >= 0) {
-        memcpy(P->pos + P->pos_off[b], pr->old->pos + pr->old->pos_off[ob],
-               sizeof *P->pos * FCM__SCHWARZ_PACKED(m, 0));
-        P->full[b] = pr->old->full[ob];
-        carried++;
-      } else {
-        scan_pattern(C, tri, m, P->dofs + P->block_ptr[b], loc, P->pos + P->pos_off[b],
-                     &P->full[b]);
-      }
+      for (fcm_index b = 0; b < nb; b++)
+        carried += positions_range(P, C, tri, pr, optr, oblk, b, b + 1, loc);
     }
   }
   P->carried = carried;
