@@ -360,8 +360,11 @@ FCM_MULTIVERSION_CLONES static void nnls_more(nnls_qr *s, const double *A, const
   const double floor = NNLS_BATCH_TAU * g[first] * inv[first];
   int nc = 0, chosen[NNLS_BATCH], nch = 1;
   chosen[0] = first;
-  for (int j = 0; j < s->kcols; j++)
-    if (seen[j] != it && pas[j] != it && g[j] * inv[j] >= floor) order[nc++] = j;
+  const int k = s->kcols;
+  for (int j = 0; j < k; j++) { /* without a branch: which columns pass is unpredictable */
+    order[nc] = j;
+    nc += (seen[j] != it) & (pas[j] != it) & (g[j] * inv[j] >= floor);
+  }
   for (int a = 0; a < nc && a < 4 * NNLS_BATCH && nch < NNLS_BATCH && s->np < M; a++) {
     /* the steepest of the rest: a partial selection sort (few are taken) */
     int b = a;
@@ -412,9 +415,15 @@ static int nnls_shortlist(int M, int k, const double *A, const double *inv, cons
 static int nnls_farkas(int M, int k, const double *b, const double *r, const double *g,
                        const double *norm, const double *inv0, double err, double reach)
 {
-  double gamma = -INFINITY;
-  for (int j = 0; j < k; j++)
-    gamma = max2(gamma, (g[j] + err * norm[j]) * inv0[j]);
+  double c[4] = {-INFINITY, -INFINITY, -INFINITY,
+                 -INFINITY}; /* four chains (fcm__nnls_top_cosine()) */
+  int j = 0;
+  for (; j + 4 <= k; j += 4)
+    for (int l = 0; l < 4; l++)
+      c[l] = max2(c[l], (g[j + l] + err * norm[j + l]) * inv0[j + l]);
+  for (; j < k; j++)
+    c[0] = max2(c[0], (g[j] + err * norm[j]) * inv0[j]);
+  const double gamma = max2(max2(c[0], c[1]), max2(c[2], c[3]));
   double by = -gamma * b[0], mag = fabs(gamma * b[0]), y1 = fabs(r[0] - gamma);
   for (int i = 0; i < M; i++)
     by += b[i] * r[i], mag += fabs(b[i] * r[i]);
@@ -551,6 +560,45 @@ static void nnls_end(fcm_ctx *ctx, nnls_qr *s, nnls_work *w)
     fcm__free(ctx, p[i]);
 }
 
+/* NNLS's scans of the k columns are maxima: each in four chains side by side, whose latency
+ * the one chain of a single running maximum paid in full. A maximum is exact, so the chains
+ * give the value the one chain gives (NaNs left out alike, as max2() leaves them out). */
+
+double fcm__nnls_top_cosine(int k, const double *g, const double *inv, const int *pas, int it)
+{
+  double c[4] = {0.0, 0.0, 0.0, 0.0};
+  int j = 0;
+  for (; j + 4 <= k; j += 4)
+    for (int l = 0; l < 4; l++)
+      c[l] = pas[j + l] != it ? max2(c[l], g[j + l] * inv[j + l]) : c[l];
+  for (; j < k; j++)
+    c[0] = pas[j] != it ? max2(c[0], g[j] * inv[j]) : c[0];
+  return max2(max2(c[0], c[1]), max2(c[2], c[3]));
+}
+
+/* Each chain keeps its first largest; of the chains' the largest, the first on a tie. */
+int fcm__nnls_steepest(int k, const double *g, const double *inv, const int *seen, const int *pas,
+                       int it, double floor)
+{
+  double best[4] = {floor, floor, floor, floor};
+  int at[4] = {-1, -1, -1, -1};
+  int j = 0;
+  for (; j + 4 <= k; j += 4)
+    for (int l = 0; l < 4; l++) {
+      const double c = g[j + l] * inv[j + l];
+      if (c > best[l] && seen[j + l] != it && pas[j + l] != it) best[l] = c, at[l] = j + l;
+    }
+  for (; j < k; j++) {
+    const double c = g[j] * inv[j];
+    if (c > best[0] && seen[j] != it && pas[j] != it) best[0] = c, at[0] = j;
+  }
+  int t = -1;
+  double b = floor;
+  for (int l = 0; l < 4; l++)
+    if (at[l] >= 0 && (t < 0 || best[l] > b || (best[l] == b && at[l] < t))) b = best[l], t = at[l];
+  return t;
+}
+
 /* The gradient g = A^T r of iteration it (residual norm rn): in full (*single: from the float
  * copy, falling back to double near optimality) or on the shortlist (g 0 elsewhere). Returns a
  * full gradient's error per unit ||a_j|| (for the certificate), -1 for the shortlist's. */
@@ -564,13 +612,9 @@ static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int 
       w->rf[i] = (float)w->r[i];
     fcm__fit_sgemv_t(NNLS_MF(M), k, w->Af, NNLS_MF(M), w->rf, w->gf);
     const float *gf = w->gf;
-    const double *inv = w->inv;
-    const int *pas = w->pas;
-    double top = 0.0;
-    for (int j = 0; j < k; j++) {
+    for (int j = 0; j < k; j++)
       g[j] = (double)gf[j];
-      if (pas[j] != it) top = max2(top, g[j] * inv[j]);
-    }
+    const double top = fcm__nnls_top_cosine(k, g, w->inv, w->pas, it);
     s->flops += 2.0 * M * k + 2.0 * k;
     if (top > NNLS_SINGLE_TRUST * rn) {
       w->last_full = it;
@@ -614,12 +658,8 @@ static int nnls_enter(nnls_qr *s, nnls_work *w, const double *A, const double *b
     const double *g = w->g, *inv = w->inv;
     const int *seen = w->seen, *pas = w->pas;
     for (;;) { /* the steepest column that can enter */
-      int t = -1;
-      double best = NNLS_GRAD_TOL * rn; /* the cosine of a_j and r, times ||r|| */
-      for (int j = 0; j < k; j++) {
-        const double c = g[j] * inv[j];
-        if (c > best && seen[j] != it && pas[j] != it) best = c, t = j;
-      }
+      /* the cosine of a_j and r, times ||r||, above the tolerance */
+      const int t = fcm__nnls_steepest(k, g, inv, seen, pas, it, NNLS_GRAD_TOL * rn);
       if (t < 0 && (!full || single)) { /* none on the shortlist or priced in single */
         full = 1, single = 0;
         break;
