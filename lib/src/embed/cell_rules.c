@@ -96,9 +96,11 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   R->stats.time_gather = fcm_wtime() - t_loop;
   R->stats.time_total = fcm_wtime() - t_start;
 cleanup:
-  if (out)
+  if (out) { /* many small arrays per integrated cell: freed on the context's threads */
+#pragma omp parallel for num_threads(fcm_ctx_num_threads(ctx)) schedule(dynamic, 256) if (nc > 4096)
     for (fcm_index c = 0; c < nc; c++)
       fcm__embed_cell_out_free(ctx, out + c);
+  }
   fcm__free(ctx, out);
   fcm__embed_build_release(&B);
   return st;
