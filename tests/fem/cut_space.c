@@ -7,6 +7,10 @@
  * and a space before the cut with one stale offset, two cells of its block order or two blocks
  * of different colours swapped, gives a different space (the offsets, the blocks and their
  * colours are taken where neither space has constrained copies, and the comparison sees them).
+ * No piece counts as copied (fcm__cell_rules_piece_copied()) from rules its rules do not extend
+ * (the same cut made again, the grandparent, the parent built anew: pieces alike; the parent made
+ * with other bits), and the elements a cut leaves against the last are those a bitwise
+ * comparison finds.
  * The spaces (and a local space) made on 1, 2 and 3 threads are the same bit for bit.
  * Usage: fem_cut_space <element> */
 #include "fem/fem_impl.h"
@@ -58,10 +62,38 @@ static int same_space(const fcm_space *a, const fcm_space *b)
   return ok && !a->local_elem && !b->local_elem && !a->elem_lcopy && !b->elem_lcopy;
 }
 
+/* 1 when piece p of r and piece q of s hold the same bits: every volume rule kind's points,
+ * weights and flags, and the surface rule's points, weights and normals. */
+static int same_piece_bits(const fcm_cell_rules *r, fcm_index p, const fcm_cell_rules *s,
+                           fcm_index q)
+{
+  int ok = 1;
+  for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
+    int na = 0, nb = 0;
+    const double *xa = NULL, *xb = NULL, *wa = NULL, *wb = NULL;
+    const unsigned char *fa = NULL, *fb = NULL;
+    if (fcm_cell_rules_has_kind(r, (fcm_rule_kind)k) !=
+        fcm_cell_rules_has_kind(s, (fcm_rule_kind)k))
+      return 0;
+    if (!fcm_cell_rules_has_kind(r, (fcm_rule_kind)k)) continue;
+    fcm_cell_rules_get_piece(r, p, (fcm_rule_kind)k, &na, &xa, &wa, &fa);
+    fcm_cell_rules_get_piece(s, q, (fcm_rule_kind)k, &nb, &xb, &wb, &fb);
+    ok = ok && na == nb && same(xa, xb, 3 * (size_t)na, sizeof *xa) &&
+         same(wa, wb, (size_t)na, sizeof *wa) && same(fa, fb, (size_t)na, 1);
+  }
+  int na = 0, nb = 0;
+  const double *xa = NULL, *xb = NULL, *wa = NULL, *wb = NULL, *ma = NULL, *mb = NULL;
+  fcm_cell_rules_get_piece_surface(r, p, &na, &xa, &wa, &ma, NULL);
+  fcm_cell_rules_get_piece_surface(s, q, &nb, &xb, &wb, &mb, NULL);
+  return ok && na == nb && same(xa, xb, 3 * (size_t)na, sizeof *xa) &&
+         same(wa, wb, (size_t)na, sizeof *wa) && same(ma, mb, 3 * (size_t)na, sizeof *ma);
+}
+
 /* The elements the cut left (fcm__space_cut_same_elements()) with the pieces the cut copied
  * taken as such (fcm__cell_rules_piece_copied()) are those found by comparing every piece's
- * bits; every copied piece holds its parent's bits, some do, and none is copied from rules its
- * rules do not extend. Returns the elements the cut left. */
+ * bits; every copied piece holds its parent's bits, some do, and none is copied from the rules
+ * themselves (other rules they do not extend: run_copied()). Returns the elements the cut
+ * left. */
 static fcm_index check_same_elements(const fcm_space *from, const fcm_space *to)
 {
   fcm_cell_rules *r = (fcm_cell_rules *)to->rules;
@@ -79,17 +111,7 @@ static fcm_index check_same_elements(const fcm_space *from, const fcm_space *to)
   for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(r); p++) {
     TEST_TRUE(!fcm__cell_rules_piece_copied(r, p, r));
     if (!fcm__cell_rules_piece_copied(r, p, from->rules)) continue;
-    const fcm_index q = fcm_cell_rules_piece_parent(r, p);
-    for (int k = 0; k < FCM_RULE_KIND_COUNT; k++) {
-      int na = 0, nb = 0;
-      const double *xa = NULL, *xb = NULL, *wa = NULL, *wb = NULL;
-      const unsigned char *fa = NULL, *fb = NULL;
-      if (!fcm_cell_rules_has_kind(r, (fcm_rule_kind)k)) continue;
-      fcm_cell_rules_get_piece(r, p, (fcm_rule_kind)k, &na, &xa, &wa, &fa);
-      fcm_cell_rules_get_piece(from->rules, q, (fcm_rule_kind)k, &nb, &xb, &wb, &fb);
-      TEST_TRUE(na == nb && same(xa, xb, 3 * (size_t)na, sizeof *xa) &&
-                same(wa, wb, (size_t)na, sizeof *wa) && same(fa, fb, (size_t)na, 1));
-    }
+    TEST_TRUE(same_piece_bits(r, p, from->rules, fcm_cell_rules_piece_parent(r, p)));
     copied += fcm_cell_rules_class(r, fcm_cell_rules_piece_cell(r, p)) == FCM_CELL_CUT;
   }
   TEST_TRUE(copied > 0 && nfast > 0 && nfast < ne);
@@ -354,6 +376,115 @@ static int run_threads(const fcm_mesh *mesh, const fcm_geometry *g, double ratio
   return compared;
 }
 
+/* No piece counts as copied from rules its rules do not extend (fcm__cell_rules_piece_copied()
+ * names the rules extended), though their pieces hold the same bits: over the three cuts, not
+ * from the same cut made again on the parent (its pieces bit for bit the cut's), not from the
+ * grandparent, not from the parent built anew (its bits the parent's) nor from rules of the same
+ * pieces with other bits (the parent's chain made with a stiffness strength one lower). The
+ * elements the cut left, found from a space on the latter (fcm__space_cut_same_elements()),
+ * are those found by comparing every piece's bits, though some of them hold pieces copied from
+ * the parent: taken as copied, they would be kept. Returns the cuts checked. */
+static int run_copied(const fcm_mesh *mesh, const fcm_geometry *g, fcm_element_type type)
+{
+  const fcm_space_options so = fcm_space_options_default();
+  /* stiffness rules only (the mass rules' fits would take most of the time) */
+  fcm_cell_rules_options ro = fcm_cell_rules_options_default();
+  ro.kinds = FCM_RULES_STIFFNESS;
+  fcm_cell_rules_options other = ro;
+  other.strength[FCM_RULE_STIFFNESS] = fcm_element_get_info(type)->stiffness_strength - 1;
+  fcm_cell_rules *rules[4] = {NULL}, *alike[4] = {NULL}, *twin[4] = {NULL}, *anew = NULL,
+                 *anew_cut = NULL;
+  fcm_space *space[4] = {NULL}, *alike_space[4] = {NULL};
+  int checked = 0;
+  const double box_lo[3] = {-0.2, -0.2, -0.2}, box_hi[3] = {1.2, 0.8, 0.8};
+  const double p1[3] = {0.47, 0.3, 0.3}, n1[3] = {1.0, 0.05, 0.0};
+  const double c2[3] = {0.73, 0.55, 0.3}, n2[3] = {1.0, 0.0, 0.1}, a2[3] = {0.0, 1.0, 0.0},
+               size2[2] = {0.5, 2.0};
+  const double p3[3] = {0.5, 0.33, 0.3}, n3[3] = {0.04, 1.0, 0.02};
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &ro, &rules[0]));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &other, &alike[0]));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &ro, &anew));
+  for (int k = 1; k <= 3 && rules[k - 1] && alike[k - 1]; k++) {
+    fcm_surface *cut = NULL;
+    if (k == 1) TEST_OK(ctx, fcm_surface_create_plane(ctx, p1, n1, box_lo, box_hi, &cut));
+    if (k == 2) TEST_OK(ctx, fcm_surface_create_rectangle(ctx, c2, n2, a2, size2, &cut));
+    if (k == 3) TEST_OK(ctx, fcm_surface_create_plane(ctx, p3, n3, box_lo, box_hi, &cut));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, rules[k - 1], cut, &rules[k]));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, rules[k - 1], cut, &twin[k]));
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, alike[k - 1], cut, &alike[k]));
+    if (k == 1 && anew) TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, anew, cut, &anew_cut));
+    fcm_surface_destroy(&cut);
+  }
+  for (int k = 0; k <= 3; k++) {
+    if (rules[k]) TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, rules[k], &so, &space[k]));
+    if (alike[k])
+      TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, alike[k], &so, &alike_space[k]));
+  }
+  for (int k = 1; k <= 3 && rules[k] && twin[k] && alike[k] && space[k] && alike_space[k - 1];
+       k++) {
+    const fcm_cell_rules *r = rules[k], *parent = rules[k - 1];
+    const fcm_index np = fcm_cell_rules_num_pieces(r);
+    fcm_index copied = 0, twin_alike = 0;
+    TEST_TRUE(fcm_cell_rules_num_pieces(twin[k]) == np &&
+              fcm_cell_rules_num_pieces(alike[k - 1]) == fcm_cell_rules_num_pieces(parent));
+    for (fcm_index p = 0; p < np; p++) {
+      const int c = fcm__cell_rules_piece_copied(r, p, parent);
+      copied += c;
+      /* the same cut made again on the parent: the same pieces, the same bits, copied from
+       * the parent alike, but neither copied from the other */
+      twin_alike += same_piece_bits(r, p, twin[k], p);
+      TEST_TRUE(fcm__cell_rules_piece_copied(twin[k], p, parent) == c);
+      TEST_TRUE(!fcm__cell_rules_piece_copied(r, p, twin[k]) &&
+                !fcm__cell_rules_piece_copied(twin[k], p, r));
+      TEST_TRUE(!fcm__cell_rules_piece_copied(r, p, alike[k - 1]));
+      if (k >= 2) TEST_TRUE(!fcm__cell_rules_piece_copied(r, p, rules[k - 2]));
+      if (k == 1 && anew_cut) { /* the parent built anew: its own cut copies from it */
+        TEST_TRUE(!fcm__cell_rules_piece_copied(r, p, anew));
+        TEST_TRUE(fcm__cell_rules_piece_copied(anew_cut, p, anew) == c);
+        TEST_TRUE(same_piece_bits(parent, fcm_cell_rules_piece_parent(r, p), anew,
+                                  fcm_cell_rules_piece_parent(r, p)));
+      }
+    }
+    TEST_TRUE(copied > 0 && twin_alike == np);
+    /* a space on rules with the parent's pieces but not its bits: only the uncut elements and
+     * the cut pieces whose bits happen to agree are left, as a bitwise comparison finds */
+    const fcm_space *from = alike_space[k - 1], *to = space[k];
+    const fcm_index ne = to->num_elems;
+    fcm_index *fast = malloc(sizeof *fast * (size_t)ne + 1),
+              *slow = malloc(sizeof *slow * (size_t)ne + 1);
+    fcm_index nfast = -1, nslow = -2, wrong = 0;
+    TEST_OK(ctx, fcm__space_cut_same_elements(from, to, fast, &nfast));
+    fcm_cell_rules *rw = (fcm_cell_rules *)r;
+    unsigned char *flags = rw->piece_copied;
+    rw->piece_copied = NULL; /* compared bit for bit */
+    TEST_OK(ctx, fcm__space_cut_same_elements(from, to, slow, &nslow));
+    rw->piece_copied = flags;
+    TEST_TRUE(nfast == nslow && same(fast, slow, (size_t)ne, sizeof *fast));
+    for (fcm_index e = 0; e < ne; e++) { /* copied cut pieces the bitwise comparison rejects */
+      const fcm_index p = to->elem_piece[e];
+      wrong += fcm_cell_rules_class(r, to->elem_cell[e]) == FCM_CELL_CUT &&
+               fcm__cell_rules_piece_copied(r, p, parent) && slow[e] < 0;
+    }
+    TEST_TRUE(wrong > 0 && nslow > 0);
+    printf("copied cut %d: %lld of %lld pieces copied; from other bits %lld of %lld elements "
+           "left, %lld copied cut pieces not\n",
+           k, (long long)copied, (long long)np, (long long)nslow, (long long)ne, (long long)wrong);
+    free(fast);
+    free(slow);
+    checked++;
+  }
+  for (int k = 3; k >= 0; k--) {
+    fcm_space_destroy(&space[k]);
+    fcm_space_destroy(&alike_space[k]);
+    fcm_cell_rules_destroy(&rules[k]);
+    fcm_cell_rules_destroy(&alike[k]);
+    fcm_cell_rules_destroy(&twin[k]);
+  }
+  fcm_cell_rules_destroy(&anew_cut);
+  fcm_cell_rules_destroy(&anew);
+  return checked;
+}
+
 int main(int argc, char **argv)
 {
   fcm_element_type type;
@@ -371,6 +502,7 @@ int main(int argc, char **argv)
   /* the tets' active cells make several blocks (the hexahedra's fit in one) */
   if (fcm_element_get_info(type)->num_corners == 4) TEST_TRUE(block_colors_swapped > 0);
   TEST_TRUE(run_take(mesh, g) >= 2); /* the third cut adds more than the room */
+  TEST_TRUE(run_copied(mesh, g, type) == 3);
   TEST_TRUE(run_threads(mesh, g, fcm_space_options_default().constrain_ratio) == 6);
   TEST_TRUE(run_threads(mesh, g, 0.2) == 6);
   fcm_geometry_destroy(&g);
