@@ -151,39 +151,6 @@ cleanup:
   return st;
 }
 
-/* Append polygon j of `from` (its piece p) to `to`. */
-static fcm_status polys_append(fcm_ctx *ctx, fcm__embed_polys *to, const fcm__embed_polys *from,
-                               size_t j, size_t first_x, fcm_index p)
-{
-  fcm_status st = FCM_OK;
-  const int n = from->nv[j];
-  if (to->n + 1 > to->cap) {
-    const size_t cap = to->cap ? 2 * to->cap : 64;
-    void *a = to->nv, *b = to->piece;
-    FCM_TRY(ctx, fcm__resize(ctx, &a, to->n, cap, sizeof(int)));
-    to->nv = a;
-    FCM_TRY(ctx, fcm__resize(ctx, &b, to->n, cap, sizeof(fcm_index)));
-    to->piece = b;
-    to->cap = cap;
-  }
-  if (to->nx + (size_t)n > to->capx) {
-    size_t cap = to->capx ? 2 * to->capx : 256;
-    while (cap < to->nx + (size_t)n)
-      cap *= 2;
-    void *a = to->x;
-    FCM_TRY(ctx, fcm__resize(ctx, &a, 3 * to->nx, 3 * cap, sizeof(double)));
-    to->x = a;
-    to->capx = cap;
-  }
-  memcpy(to->x + 3 * to->nx, from->x + 3 * first_x, 3 * (size_t)n * sizeof *to->x);
-  to->nv[to->n] = n;
-  to->piece[to->n] = p;
-  to->n++;
-  to->nx += (size_t)n;
-cleanup:
-  return st;
-}
-
 /* Polygons clipped ahead: those of the (cell, triangle) pairs pairs[0 .. n) (sorted), pair k's
  * polys.x from xoff[k], polygons off[k] .. off[k + 1] of polys; clipped[k]: whether pair k was
  * clipped (a pair left out has no polygons here). */
@@ -486,13 +453,14 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
     if (reused) {
       size_t first_x = es->xoff[j]; /* the parts the last rebuild clipped */
       for (size_t q = es->poff[j]; q < es->poff[j + 1]; first_x += (size_t)es->polys.nv[q++])
-        FCM_TRY(ctx, polys_append(ctx, polys, &es->polys, q, first_x,
-                                  map_piece(es, c, es->polys.piece[q])));
+        FCM_TRY(ctx, fcm__embed_polys_push(ctx, polys, es->polys.x + 3 * first_x, es->polys.nv[q],
+                                           map_piece(es, c, es->polys.piece[q])));
     } else if (jp < pre->n && pre->clipped[jp] &&
                !fcm__surface_cmp_pair(pre->pairs + 2 * jp, pairs + 2 * k)) {
       size_t first_x = pre->xoff[jp]; /* clipped while mark_split() had the cell's parts */
       for (size_t q = pre->off[jp]; q < pre->off[jp + 1]; first_x += (size_t)pre->polys.nv[q++])
-        FCM_TRY(ctx, polys_append(ctx, polys, &pre->polys, q, first_x, pre->polys.piece[q]));
+        FCM_TRY(ctx, fcm__embed_polys_push(ctx, polys, pre->polys.x + 3 * first_x, pre->polys.nv[q],
+                                           pre->polys.piece[q]));
     } else {
       double x[9];
       tri_coords(es, t, x);
