@@ -416,6 +416,11 @@ typedef struct fcm__embed_polys {
 
 void fcm__embed_polys_free(fcm_ctx *ctx, fcm__embed_polys *p);
 
+/* Append polygon x (n vertices, 3 n doubles) of `piece` to out, its arrays doubled as they
+ * fill. */
+fcm_status fcm__embed_polys_push(fcm_ctx *ctx, fcm__embed_polys *out, const double *x, int n,
+                                 fcm_index piece);
+
 /* A finder for the geometry `geom` embedded in `mesh` (both borrowed; the search tree of the
  * geometry's cells is built here, once). */
 fcm_status fcm__embed_finder_create(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *geom,

@@ -267,9 +267,8 @@ static double polygon_area(const double *x, int n)
   return 0.5 * sqrt(fcm__vec3_dot(a, a));
 }
 
-/* Append polygon x (n vertices) of `piece` to out. */
-static fcm_status polys_push(fcm_ctx *ctx, fcm__embed_polys *out, const double *x, int n,
-                             fcm_index piece)
+fcm_status fcm__embed_polys_push(fcm_ctx *ctx, fcm__embed_polys *out, const double *x, int n,
+                                 fcm_index piece)
 {
   fcm_status st = FCM_OK;
   if (out->n + 1 > out->cap) {
@@ -330,7 +329,7 @@ fcm_status fcm__embed_finder_clip(fcm__embed_finder *f, fcm_index c, const doubl
   if (n < 3) goto cleanup;
   if (np < 2) {
     if (polygon_area(cpoly, n) > amin)
-      FCM_TRY(ctx, polys_push(ctx, out, cpoly, n, np ? R->piece_off[c] : -1));
+      FCM_TRY(ctx, fcm__embed_polys_push(ctx, out, cpoly, n, np ? R->piece_off[c] : -1));
     goto cleanup;
   }
   FCM_TRY(ctx, load_cell(f, c, 1));
@@ -343,7 +342,7 @@ fcm_status fcm__embed_finder_clip(fcm__embed_finder *f, fcm_index c, const doubl
               "exceeded %d vertices",
               (long long)c, POLYGON_CAP);
     if (m >= 3 && polygon_area(poly, m) > amin)
-      FCM_TRY(ctx, polys_push(ctx, out, poly, m, part_piece(f, i)));
+      FCM_TRY(ctx, fcm__embed_polys_push(ctx, out, poly, m, part_piece(f, i)));
   }
 cleanup:
   return st;

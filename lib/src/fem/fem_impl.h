@@ -567,10 +567,10 @@ fcm_status fcm__space_write_vtu_piece(const fcm_space *s, const fcm_material *ma
                                       const double *v, const unsigned char *keep, int rank,
                                       const char *path, fcm_index *nonfinite);
 
-/* The embedded surface (surface.c builds it, fields.c writes it). Points: the boundary
- * vertices [0, nb), then the vertices of the parts of the boundary triangles the cuts split,
- * then three per cut-face triangle. Triangles: the boundary triangles no cut splits (in their
- * order), the parts of the split ones (fans of their polygons), the cut faces. */
+/* The embedded surface (surface.c and surface_split.c build it, fields.c writes it). Points: the
+ * boundary vertices [0, nb), then the vertices of the parts of the boundary triangles the cuts
+ * split, then three per cut-face triangle. Triangles: the boundary triangles no cut splits (in
+ * their order), the parts of the split ones (fans of their polygons), the cut faces. */
 struct fcm_embedded_surface {
   fcm_ctx *ctx;
   const fcm_space *space;
@@ -592,7 +592,7 @@ struct fcm_embedded_surface {
   /* tests: the rebuild clips no pair ahead (split_triangles() clips every pair it splits) */
   int test_no_preclip;
   /* What the last rebuild with cuts found, for the next one on rules that extend its rules
-   * by further cuts (surface.c: cells no new cut triangle reaches keep their answers):
+   * by further cuts (surface_split.c: cells no new cut triangle reaches keep their answers):
    * those rules' cut triangles (copied), pieces per cell (piece_off, num cells + 1), the
    * piece of each boundary vertex in a cell of several pieces (vpiece, nb; -3: not looked
    * up), and the parts of each (cell, triangle) pair clipped (pairs sorted, 2 x npairs;

@@ -1,6 +1,7 @@
 list(APPEND FCM_SOURCES lib/src/fem/space.c lib/src/fem/numbering.c lib/src/fem/topology.c
      lib/src/fem/visit.c
-     lib/src/fem/assemble.c lib/src/fem/assemble_once.c lib/src/fem/corot_store.c lib/src/fem/locate.c lib/src/fem/surface.c)
+     lib/src/fem/assemble.c lib/src/fem/assemble_once.c lib/src/fem/corot_store.c lib/src/fem/locate.c lib/src/fem/surface.c
+     lib/src/fem/surface_split.c)
 list(APPEND FCM_SOURCES lib/src/fem/blocks.c lib/src/fem/fields.c lib/src/fem/eval.c
      lib/src/fem/motion.c lib/src/fem/cut_update.c lib/src/fem/hanging.c
      lib/src/fem/indicator.c lib/src/fem/refine_transfer.c)
