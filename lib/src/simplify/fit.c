@@ -576,29 +576,6 @@ double fcm__nnls_top_cosine(int k, const double *g, const double *inv, const int
   return max2(max2(c[0], c[1]), max2(c[2], c[3]));
 }
 
-/* Each chain keeps its first largest; of the chains' the largest, the first on a tie. */
-int fcm__nnls_steepest(int k, const double *g, const double *inv, const int *seen, const int *pas,
-                       int it, double floor)
-{
-  double best[4] = {floor, floor, floor, floor};
-  int at[4] = {-1, -1, -1, -1};
-  int j = 0;
-  for (; j + 4 <= k; j += 4)
-    for (int l = 0; l < 4; l++) {
-      const double c = g[j + l] * inv[j + l];
-      if (c > best[l] && seen[j + l] != it && pas[j + l] != it) best[l] = c, at[l] = j + l;
-    }
-  for (; j < k; j++) {
-    const double c = g[j] * inv[j];
-    if (c > best[0] && seen[j] != it && pas[j] != it) best[0] = c, at[0] = j;
-  }
-  int t = -1;
-  double b = floor;
-  for (int l = 0; l < 4; l++)
-    if (at[l] >= 0 && (t < 0 || best[l] > b || (best[l] == b && at[l] < t))) b = best[l], t = at[l];
-  return t;
-}
-
 /* The gradient g = A^T r of iteration it (residual norm rn): in full (*single: from the float
  * copy, falling back to double near optimality) or on the shortlist (g 0 elsewhere). Returns a
  * full gradient's error per unit ||a_j|| (for the certificate), -1 for the shortlist's. */
@@ -658,8 +635,12 @@ static int nnls_enter(nnls_qr *s, nnls_work *w, const double *A, const double *b
     const double *g = w->g, *inv = w->inv;
     const int *seen = w->seen, *pas = w->pas;
     for (;;) { /* the steepest column that can enter */
-      /* the cosine of a_j and r, times ||r||, above the tolerance */
-      const int t = fcm__nnls_steepest(k, g, inv, seen, pas, it, NNLS_GRAD_TOL * rn);
+      int t = -1;
+      double best = NNLS_GRAD_TOL * rn; /* the cosine of a_j and r, times ||r|| */
+      for (int j = 0; j < k; j++) {
+        const double c = g[j] * inv[j];
+        if (c > best && seen[j] != it && pas[j] != it) best = c, t = j;
+      }
       if (t < 0 && (!full || single)) { /* none on the shortlist or priced in single */
         full = 1, single = 0;
         break;

@@ -245,14 +245,10 @@ static inline double fcm__fit_dot(int n, const double *x, const double *y)
   return t;
 }
 
-/* NNLS's pricing scans (fit.c), in chains side by side, the values and columns a single running
- * maximum gives, NaNs left out: the largest g_j inv_j over the columns j not passive in
- * iteration it (pas[j] != it), 0 if none is larger; the first column j of the largest
- * g_j inv_j above `floor` among those neither tried nor passive in iteration it (seen[j],
- * pas[j] != it), -1 for none. */
+/* NNLS's largest cosine (fit.c): max2() of g_j inv_j over the columns j not passive in
+ * iteration it (pas[j] != it), 0 if none is larger; in chains side by side, the value one
+ * running maximum gives, NaNs left out. */
 double fcm__nnls_top_cosine(int k, const double *g, const double *inv, const int *pas, int it);
-int fcm__nnls_steepest(int k, const double *g, const double *inv, const int *seen, const int *pas,
-                       int it, double floor);
 
 /* y = A^T x for A (m x n, column-major, leading dimension lda): NNLS's products
  * (fit_kernels.c). The single-precision one needs m a multiple of 16 (rows padded with zeros). */
