@@ -161,18 +161,6 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
   return prep;
 }
 
-/* failing_alloc() for allocations from several threads: the count taken atomically, so that
- * exactly one allocation, whichever thread makes it, is the fail_at-th. */
-static void *team_failing_alloc(void *user, size_t size)
-{
-  failing *f = user;
-  long long k;
-#pragma omp atomic capture
-  k = f->count++;
-  if (f->fail_at >= 0 && k == f->fail_at) return NULL;
-  return malloc(size);
-}
-
 /* Allocations made to fail, spread over a carry made beside: level 0's task makes few of them,
  * and its thread interleaves them with the coarser levels'. */
 enum { BESIDE_FAILURES = 60 };
@@ -184,12 +172,8 @@ static void failing_besides(const fcm_mg *old, const problem *cur, const problem
                             const fcm_mg_options *o, const unsigned char *inactive)
 {
   failing fl = {0, -1};
-  fcm_ctx_options co = fcm_ctx_options_default();
-  co.allocator.alloc = team_failing_alloc;
-  co.allocator.release = failing_release;
-  co.allocator.user = &fl;
-  fcm_ctx *fctx = NULL;
-  TEST_OK(NULL, fcm_ctx_create(&co, &fctx));
+  fcm_ctx *fctx = failing_ctx_with(&fl, failing_alloc_atomic); /* the two threads allocate */
+  TEST_TRUE(fctx != NULL);
   fcm_mg *mg = NULL;
   TEST_OK(fctx, fcm__mg_create_pattern_cut_beside(fctx, old, cur->space, next->space, next->A,
                                                   inactive, o, &mg));

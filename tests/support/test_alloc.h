@@ -42,11 +42,22 @@ static inline void failing_release(void *user, void *p)
   free(p);
 }
 
-/* A context whose allocator is `f` (f->fail_at = -1 until the loop arms it). */
-static inline fcm_ctx *failing_ctx(failing *f)
+/* failing_alloc() for allocations from several threads: the count taken atomically, so that
+ * exactly one allocation, whichever thread makes it, is the fail_at-th. */
+static inline void *failing_alloc_atomic(void *user, size_t size)
+{
+  failing *f = user;
+  const long long k = __atomic_fetch_add(&f->count, 1, __ATOMIC_RELAXED);
+  if (f->fail_at >= 0 && k == f->fail_at) return NULL;
+  return malloc(size);
+}
+
+/* A context whose allocator is `f` through `alloc` (failing_alloc or failing_alloc_atomic;
+ * f->fail_at = -1 until the loop arms it). */
+static inline fcm_ctx *failing_ctx_with(failing *f, void *(*alloc)(void *, size_t))
 {
   fcm_ctx_options o = fcm_ctx_options_default();
-  o.allocator.alloc = failing_alloc;
+  o.allocator.alloc = alloc;
   o.allocator.release = failing_release;
   o.allocator.user = f;
   f->count = 0;
@@ -54,6 +65,12 @@ static inline fcm_ctx *failing_ctx(failing *f)
   fcm_ctx *ctx = NULL;
   if (fcm_ctx_create(&o, &ctx) != FCM_OK) return NULL;
   return ctx;
+}
+
+/* A context whose allocator is `f` (f->fail_at = -1 until the loop arms it). */
+static inline fcm_ctx *failing_ctx(failing *f)
+{
+  return failing_ctx_with(f, failing_alloc);
 }
 
 #endif
