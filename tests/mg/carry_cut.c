@@ -161,46 +161,78 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
   return prep;
 }
 
-/* Allocations made to fail, spread over a carry made beside: level 0's task makes few of them,
- * and its thread interleaves them with the coarser levels'. */
-enum { BESIDE_FAILURES = 60 };
+/* A carry made beside by one thread of a team of two while the other waits, without a task
+ * scheduling point, until the creation has returned: level 0's task then runs at the team's
+ * barrier (libgomp runs no other task at the creation's own task loops), after the coarser
+ * levels, so that the allocations come in one order, the creation's then the task's.
+ * *at_return: the allocations counted when the creation returned. */
+static fcm_status held_beside(fcm_ctx *ctx, failing *fl, const fcm_mg *old, const problem *cur,
+                              const problem *next, const fcm_mg_options *o,
+                              const unsigned char *inactive, fcm_mg **mg, long long *at_return)
+{
+  fcm_status st = FCM_OK;
+  int done = 0;
+#pragma omp parallel num_threads(2)
+  {
+#pragma omp single nowait
+    {
+      st = fcm__mg_create_pattern_cut_beside(ctx, old, cur->space, next->space, next->A, inactive,
+                                             o, mg);
+      *at_return = __atomic_load_n(&fl->count, __ATOMIC_RELAXED);
+#pragma omp atomic write
+      done = 1;
+    }
+    for (int d = 0; !d;) {
+#pragma omp atomic read
+      d = done;
+    }
+  }
+  return st;
+}
 
-/* Carries made beside (a team of two, joined after its barrier) whose allocations fail at
- * several places, in the coarser levels' part or in level 0's task: FCM_ERR_ALLOC from the
- * creation or from the join, nothing leaked (the failed hierarchy destroyed). */
+/* Allocations made to fail in each of the two parts of a carry made beside. */
+enum { BESIDE_FAILURES = 12 };
+
+/* Carries made beside (held_beside(), joined after the barrier) whose allocations fail, at
+ * places spread over the creation's and over level 0's task's: FCM_ERR_ALLOC from the
+ * creation for the first, from the join for the second (the creation then succeeds, its task
+ * pending), nothing leaked (the failed hierarchy destroyed). */
 static void failing_besides(const fcm_mg *old, const problem *cur, const problem *next,
                             const fcm_mg_options *o, const unsigned char *inactive)
 {
   failing fl = {0, -1};
   fcm_ctx *fctx = failing_ctx_with(&fl, failing_alloc_atomic); /* the two threads allocate */
   TEST_TRUE(fctx != NULL);
+  if (!fctx) return;
   fcm_mg *mg = NULL;
-  TEST_OK(fctx, fcm__mg_create_pattern_cut_beside(fctx, old, cur->space, next->space, next->A,
-                                                  inactive, o, &mg));
+  long long made = 0;
+  TEST_OK(fctx, held_beside(fctx, &fl, old, cur, next, o, inactive, &mg, &made));
+  TEST_TRUE(mg && mg->beside != NULL); /* the task was left pending */
   TEST_OK(fctx, fcm__mg_join(mg, NULL));
   const long long total = fl.count;
+  TEST_TRUE(made > 1 && total > made + 1); /* both parts allocate */
   fcm_mg_destroy(&mg);
   const long long live = fcm_ctx_live_allocations(fctx);
-  int failures = 0, in_join = 0;
-  for (int q = 0; q < BESIDE_FAILURES; q++) {
-    fl.count = 0, fl.fail_at = q * total / BESIDE_FAILURES + 1;
-    fcm_status st = FCM_OK;
-#pragma omp parallel num_threads(2)
-#pragma omp single
-    st = fcm__mg_create_pattern_cut_beside(fctx, old, cur->space, next->space, next->A, inactive, o,
-                                           &mg);
-    if (st == FCM_OK) {
-      st = fcm__mg_join(mg, NULL);
-      in_join += st == FCM_ERR_ALLOC;
-      if (st != FCM_OK) fcm_mg_destroy(&mg);
+  int in_create = 0, in_join = 0;
+  for (int part = 0; part < 2; part++)
+    for (int q = 0; q < BESIDE_FAILURES; q++) {
+      const long long lo = part ? made : 0, n = part ? total - made : made;
+      long long at = 0;
+      fl.count = 0, fl.fail_at = lo + q * n / BESIDE_FAILURES;
+      fcm_status st = held_beside(fctx, &fl, old, cur, next, o, inactive, &mg, &at);
+      if (part == 0) {
+        in_create += st == FCM_ERR_ALLOC && mg == NULL;
+      } else if (st == FCM_OK) {
+        st = fcm__mg_join(mg, NULL);
+        in_join += st == FCM_ERR_ALLOC;
+        fcm_mg_destroy(&mg);
+      }
+      fl.fail_at = -1;
+      fcm_ctx_error_clear(fctx);
+      TEST_TRUE(fcm_ctx_live_allocations(fctx) == live);
     }
-    fl.fail_at = -1;
-    failures += st == FCM_ERR_ALLOC && mg == NULL;
-    fcm_ctx_error_clear(fctx);
-    TEST_TRUE(fcm_ctx_live_allocations(fctx) == live);
-  }
-  TEST_TRUE(failures == BESIDE_FAILURES);
-  TEST_TRUE(in_join > 0); /* some failed in level 0's task, reported by the join */
+  TEST_TRUE(in_create == BESIDE_FAILURES);
+  TEST_TRUE(in_join == BESIDE_FAILURES);
   fcm_ctx_destroy(&fctx);
 }
 

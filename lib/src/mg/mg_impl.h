@@ -132,9 +132,9 @@ FCM_COMPONENT_API fcm_status fcm__mg_create_pattern_cut(fcm_ctx *ctx, const fcm_
  * (scene/run.c cut_parts()): level 0's smoothing order and block smoother are made by a task
  * that any thread of the team may run, and may still be pending when this returns FCM_OK, so
  * that the calling thread goes on with other work. Until fcm__mg_join(), after the team's
- * barrier, m must not be used (fcm_mg_destroy() is allowed: it waits for the task when called
- * by the thread that created it, which the barrier makes moot), and old, old_space, space
- * and A's pattern must live. Outside an active parallel region the task runs at once. The
+ * barrier, m must not be used (fcm_mg_destroy() only by the thread that created m, whose
+ * taskwait waits for the task, or after the barrier), and old, old_space, space and A's
+ * pattern must live. Outside an active parallel region the task runs at once. The
  * result after fcm__mg_join() is fcm__mg_create_pattern_cut()'s bit for bit. */
 FCM_COMPONENT_API fcm_status fcm__mg_create_pattern_cut_beside(
     fcm_ctx *ctx, const fcm_mg *old, const fcm_space *old_space, const fcm_space *space,

@@ -474,9 +474,10 @@ static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space 
  * gives the bits it gives alone (the loops inside run on one thread then, and give the bits
  * they give on two). A distributed run makes them on the calling thread in turn. A failed
  * part gives the storage back to the old integrator, which goes on. The structure leaves
- * level 0's smoothers to a task (fcm__integrator_cut's `beside`): the thread that is free
- * first runs it, before or after the parts left, and the end completes it after the
- * barrier. seconds[1]: the solver's structure (the structure part's wall time, its task's,
+ * level 0's smoothers to a task (fcm__integrator_cut's `beside`), which the thread that
+ * reaches the team's barrier first runs, and which is completed after the barrier as part
+ * of the structure (fcm__integrator_cut_join(): its error is the structure's, ranked as
+ * such). seconds[1]: the solver's structure (the structure part's wall time, its task's,
  * and the direct solver's symbolic analysis, which the values make), seconds[0]: the rest of
  * the integrator's; side by side each its own, so they may add up to more than the cut. */
 static fcm_status cut_parts(fcm_simulation *S, const fcm_space *space, fcm_integrator **integ,
@@ -510,6 +511,11 @@ static fcm_status cut_parts(fcm_simulation *S, const fcm_space *space, fcm_integ
         if (k >= CUT_PARTS) break;
         cut_part(S, &L, order[nt > 1][k], space, &cut);
       }
+    }
+    if (!fcm__loop_skip(&L, CUT_STRUCTURE)) { /* the structure's task, done past the barrier */
+      fcm__loop_iter it;
+      fcm__loop_enter(&L, &it, CUT_STRUCTURE);
+      fcm__loop_leave(&L, &it, fcm__integrator_cut_join(&cut));
     }
     st = fcm__loop_end(&L, NULL);
   }

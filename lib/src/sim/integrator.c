@@ -825,6 +825,14 @@ fcm_status fcm__integrator_cut_structure(fcm__integrator_cut *cut)
   return st;
 }
 
+fcm_status fcm__integrator_cut_join(fcm__integrator_cut *cut)
+{
+  double task = 0.0;
+  const fcm_status st = cut->integ ? fcm__sim_join_solver(cut->integ, &task) : FCM_OK;
+  cut->seconds[1] += task;
+  return st;
+}
+
 int fcm__integrator_cut_has_structure(const fcm__integrator_cut *cut)
 {
   return cut->integ && fcm__sim_structure_wanted(cut->integ);
@@ -836,12 +844,9 @@ fcm_status fcm__integrator_cut_end(fcm__integrator_cut *cut, fcm_status st, fcm_
   fcm_ctx *ctx = cut->old ? cut->old->ctx : NULL;
   const double t0 = fcm_wtime();
   *integ = NULL;
-  if (I && st == FCM_OK) { /* the structure's task that ran beside (done: past the barrier;
-                              after a failure the integrator's destruction drops it) */
-    double task = 0.0;
-    st = fcm__sim_join_solver(I, &task);
-    cut->seconds[1] += task;
-  }
+  if (I && st == FCM_OK) /* the structure's task that ran beside, if not joined yet (done: past
+                            the barrier; after a failure the integrator's destruction drops it) */
+    st = fcm__integrator_cut_join(cut);
   if (st == FCM_OK) {
     /* the structure's active set is I's when I's state holds it (always, by
      * fcm__sim_eval_constraints()); else the first factor builds the hierarchy again */

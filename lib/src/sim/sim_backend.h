@@ -81,6 +81,11 @@ FCM_COMPONENT_API fcm_status fcm__integrator_cut_begin(const fcm_integrator *old
 FCM_COMPONENT_API fcm_status fcm__integrator_cut_values(fcm__integrator_cut *cut);
 /* The structure job, after a successful begin; beside the values job or before or after it. */
 FCM_COMPONENT_API fcm_status fcm__integrator_cut_structure(fcm__integrator_cut *cut);
+/* After the structure job run `beside`, past the team's barrier: its pending task completed
+ * (fcm__sim_join_solver(): its error, with the solver's prefix) and its time added to
+ * seconds[1]; FCM_OK at once when nothing is pending. fcm__integrator_cut_end() does it too
+ * when the stages succeeded and it was not done. */
+FCM_COMPONENT_API fcm_status fcm__integrator_cut_join(fcm__integrator_cut *cut);
 /* Whether the structure job has work (the multigrid solver's hierarchy; else it returns at
  * once), after a successful begin. */
 FCM_COMPONENT_API int fcm__integrator_cut_has_structure(const fcm__integrator_cut *cut);
