@@ -361,11 +361,12 @@ static fcm_status block_slabs(fcm_mg *m, mg_level *L)
      * create_beside()): in tasks that any thread of the team takes when it is free */
     const fcm_index nch = 8 * (fcm_index)omp_get_num_threads();
 #pragma omp taskloop default(shared) grainsize(1)
-    for (fcm_index c = 0; c < nch; c++)
-      rows_reach(L, last, n * c / nch, n * (c + 1) / nch, row_reach);
+    for (size_t c = 0; c < (size_t)nch; c++) /* size_t: clang's task loop counts so */
+      rows_reach(L, last, n * (fcm_index)c / nch, n * (fcm_index)(c + 1) / nch, row_reach);
 #pragma omp taskloop default(shared) grainsize(1)
-    for (fcm_index c = 0; c < nch; c++)
-      blocks_reach(L, seq, row_reach, nb * c / nch, nb * (c + 1) / nch, reach, work);
+    for (size_t c = 0; c < (size_t)nch; c++)
+      blocks_reach(L, seq, row_reach, nb * (fcm_index)c / nch, nb * (fcm_index)(c + 1) / nch, reach,
+                   work);
   } else {
     const fcm_index chunk = 4096;
 #pragma omp parallel for num_threads(fcm__mg_team(m)) schedule(static) if (n > chunk)

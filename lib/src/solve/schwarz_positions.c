@@ -180,10 +180,10 @@ fcm_status fcm__schwarz_positions_from(fcm_schwarz *P, const fcm_csr *C, const u
   if (omp_in_parallel() && omp_get_num_threads() <= P->nt && nb > SCAN_PARALLEL_BLOCKS) {
     const fcm_index nch = 8 * (fcm_index)omp_get_num_threads();
 #pragma omp taskloop default(shared) grainsize(1)
-    for (fcm_index c = 0; c < nch; c++) {
-      const fcm_index k =
-          positions_range(P, C, tri, pr, optr, oblk, nb * c / nch, nb * (c + 1) / nch,
-                          P->loc + (size_t)P->n * (size_t)omp_get_thread_num());
+    for (size_t c = 0; c < (size_t)nch; c++) { /* size_t: clang's task loop counts so */
+      const fcm_index k = positions_range(P, C, tri, pr, optr, oblk, nb * (fcm_index)c / nch,
+                                          nb * (fcm_index)(c + 1) / nch,
+                                          P->loc + (size_t)P->n * (size_t)omp_get_thread_num());
 #pragma omp atomic
       carried += k;
     }
