@@ -431,7 +431,7 @@ static fcm_status mg_create(fcm_ctx *ctx, fcm_mg *old, mg_carry *carry, const fc
   FCM_TRY(ctx, level_diag(m, &m->lev[0]));
   if (carry && carry->old) FCM_TRY(ctx, fcm__mg_carry_maps(m, carry));
   if (carry && carry->old && !old && m->values_pending && m->nlev > 1) {
-    FCM_TRY(ctx, create_beside(m, carry, same, defer)); /* joined: the buffers too */
+    FCM_TRY(ctx, create_beside(m, carry, same, defer)); /* the buffers at its join */
   } else {
     FCM_TRY(ctx, create_patterns(m, old, carry, same, 0));
     if (!m->values_pending) FCM_TRY(ctx, fcm_mg_setup(m));

@@ -415,8 +415,8 @@ static int nnls_shortlist(int M, int k, const double *A, const double *inv, cons
 static int nnls_farkas(int M, int k, const double *b, const double *r, const double *g,
                        const double *norm, const double *inv0, double err, double reach)
 {
-  double c[4] = {-INFINITY, -INFINITY, -INFINITY,
-                 -INFINITY}; /* four chains (fcm__nnls_top_cosine()) */
+  /* four chains side by side, as fcm__nnls_top_cosine() */
+  double c[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
   int j = 0;
   for (; j + 4 <= k; j += 4)
     for (int l = 0; l < 4; l++)
@@ -560,10 +560,9 @@ static void nnls_end(fcm_ctx *ctx, nnls_qr *s, nnls_work *w)
     fcm__free(ctx, p[i]);
 }
 
-/* NNLS's scans of the k columns are maxima: each in four chains side by side, whose latency
- * the one chain of a single running maximum paid in full. A maximum is exact, so the chains
- * give the value the one chain gives (NaNs left out alike, as max2() leaves them out). */
-
+/* Four chains side by side, whose latency one running maximum paid in full at every column. A
+ * maximum is exact, so the chains give the value the one chain gives (NaNs left out alike, as
+ * max2() leaves them out). */
 double fcm__nnls_top_cosine(int k, const double *g, const double *inv, const int *pas, int it)
 {
   double c[4] = {0.0, 0.0, 0.0, 0.0};
