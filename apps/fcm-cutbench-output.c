@@ -74,6 +74,14 @@ static void print_run(const cutbench_row *r, int k)
     printf("%9.2e\n", r->disp_diff);
   else
     printf("%9s\n", "-");
+  if (q->runs > 1) {
+    printf("%-15s %-11s medians of %d runs; the largest cut ", "", "", q->runs);
+    if (q->events > 0)
+      printf("%.4f to %.4f s", q->cut_max_lo, q->cut_max_hi);
+    else
+      printf("-");
+    printf(", the mean step %.4f to %.4f s\n", q->step_mean_lo, q->step_mean_hi);
+  }
 }
 
 void cutbench_print_row(const cutbench_row *r)
@@ -103,8 +111,10 @@ int cutbench_print_verdicts(const cutbench_row *rows, int n)
       printf("cut %.4f s (the paper gives none); ", q->cut_max);
     else
       printf("cut %.4f s <= %.4f s %s; ", q->cut_max, p->cut_s, c ? "holds" : "FAILS");
-    printf("mean step %.4f s <= %.4f s (paper/%g) %s\n", q->step_mean, p->step_factor * p->step_s,
+    printf("mean step %.4f s <= %.4f s (paper/%g) %s", q->step_mean, p->step_factor * p->step_s,
            1.0 / p->step_factor, s ? "holds" : "FAILS");
+    if (q->runs > 1) printf(" (medians of %d runs)", q->runs);
+    printf("\n");
     if (c == 0 || s == 0) fails++;
     if (rows[i].disp_diff >= 0.0)
       printf("  %-15s interactive against defaults: max |du| %.3e m (max |u| %.3e m)\n", "",
@@ -121,7 +131,8 @@ static const char csv_header[] =
     "dofs_after,cut_events,cut_s_mean,cut_s_max,cut_rules_s,cut_space_s,cut_integrator_s,"
     "cut_solver_s,cut_other_s,cut_factor_s,setup_s,steps,step_s_mean,step_s_max,newton_per_step,"
     "linear_per_step,paper_cut_s,paper_step_s,paper_step_max_s,paper_machine,cut_ratio,step_ratio,"
-    "step_target_s,cut_ok,step_ok,disp_diff_m,disp_max_m,options,note\n";
+    "step_target_s,cut_ok,step_ok,disp_diff_m,disp_max_m,runs,cut_s_max_lo,cut_s_max_hi,"
+    "step_s_mean_lo,step_s_mean_hi,options,note\n";
 
 static void csv_run(FILE *f, const cutbench_row *r, int k)
 {
@@ -167,6 +178,11 @@ static void csv_run(FILE *f, const cutbench_row *r, int k)
   cli_csv_text(f, s < 0 ? "" : s ? "yes" : "no");
   cli_csv_number(f, k == 1 ? r->disp_diff : -1.0);
   cli_csv_number(f, k == 0 ? r->disp_max : -1.0);
+  cli_csv_number(f, ok ? q->runs : -1.0);
+  cli_csv_number(f, ok && q->events > 0 ? q->cut_max_lo : -1.0);
+  cli_csv_number(f, ok && q->events > 0 ? q->cut_max_hi : -1.0);
+  cli_csv_number(f, ok ? q->step_mean_lo : -1.0);
+  cli_csv_number(f, ok ? q->step_mean_hi : -1.0);
   cli_csv_text(f, k ? r->interactive : "");
   cli_csv_text(f, ok ? "" : q->note);
   fputc('\n', f);

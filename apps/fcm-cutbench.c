@@ -42,7 +42,7 @@ static const char *const row_interactive[ROW_COUNT] = {
     "\"newton\": {\"fixed_iterations\": 1, \"project_psd\": true}"};
 
 typedef struct settings {
-  int quick, fill_holes;
+  int quick, fill_holes, repeat;
   double scale;
   long long triangles;
   const char *model, *rows, *interactive, *csv, *png, *write_scenes;
@@ -119,6 +119,10 @@ static void option_table(settings *o, cli_option opts[NUM_OPTIONS])
        "an option set run beside the defaults, as members of\nthe scene's \"solver\" object, "
        "e.g. '\"method\": \"cg\"'",
        0, 0, 0, NULL, NULL, NULL},
+      {"--repeat", NULL, CLI_INT, &o->repeat, "N",
+       "run each option set of a row N times, alternating\nthe sets; every figure the median of "
+       "the runs, the\nlargest cut's and the mean step's range beside it\n(default 1)",
+       1, 99, 0, NULL, NULL, NULL},
       {"--csv", NULL, CLI_STRING, &o->csv, "FILE", "write the rows as CSV (atomically)", 0, 0, 0,
        NULL, NULL, NULL},
       {"--png", NULL, CLI_STRING, &o->png, "FILE",
@@ -135,7 +139,7 @@ static void option_table(settings *o, cli_option opts[NUM_OPTIONS])
 static int parse_options(int argc, char **argv, settings *o)
 {
   memset(o, 0, sizeof *o);
-  o->scale = 1.0, o->triangles = 70000;
+  o->scale = 1.0, o->triangles = 70000, o->repeat = 1;
   cli_option opts[NUM_OPTIONS];
   option_table(o, opts);
   const int rc = cli_parse_args(PROG, opts, argc, argv, NULL, 0, NULL, usage);
@@ -370,34 +374,136 @@ static int write_scenes(fcm_ctx *ctx, const settings *o)
   return 0;
 }
 
-/* Run one row: the defaults, then the interactive set when there is one. */
+/* The k-th smallest of v[0 .. n) (k < n; v reordered). */
+static double kth(double *v, int n, int k)
+{
+  for (int i = 1; i < n; i++) /* a few runs: insertion sort */
+    for (int j = i; j > 0 && v[j - 1] > v[j]; j--) {
+      const double t = v[j];
+      v[j] = v[j - 1], v[j - 1] = t;
+    }
+  return v[k];
+}
+
+/* The figures of n runs of one option set into out: the medians (the lower one for an even n,
+ * so each is a run's own figure), the phases of the run whose mean cut is the median (they add
+ * up to it), the ranges of the largest cut and of the mean step. Every run must end as the
+ * first did, with its DOFs, events, steps, iterations and displacement bit for bit (a scene's
+ * run is deterministic), else out failed with a note saying which run differs. A failed run
+ * makes out that run. The runs' displacements are freed but out's. */
+static void combine_runs(cutbench_run *runs, int n, cutbench_run *out)
+{
+  int base = 0;
+  for (int i = 0; i < n; i++)
+    if (!runs[i].ok) {
+      base = i;
+      goto done;
+    }
+  for (int i = 1; i < n; i++) {
+    const cutbench_run *a = &runs[0], *b = &runs[i];
+    if (a->dofs_before != b->dofs_before || a->dofs_after != b->dofs_after ||
+        a->events != b->events || a->steps != b->steps || a->newton != b->newton ||
+        a->linear != b->linear || a->n != b->n ||
+        memcmp(a->u, b->u, sizeof *a->u * (size_t)a->n) != 0) {
+      runs[0].ok = 0;
+      snprintf(runs[0].note, sizeof runs[0].note,
+               "run %d of %d ended otherwise than the first (DOFs, cut events, steps, "
+               "iterations or displacement): the runs are not repeatable",
+               i + 1, n);
+      goto done;
+    }
+  }
+  {
+    double v[99];
+    const int mid = (n - 1) / 2;
+    for (int i = 0; i < n; i++)
+      v[i] = runs[i].cut_mean;
+    const double cut_mean = kth(v, n, mid);
+    for (int i = 0; i < n; i++)
+      if (runs[i].cut_mean == cut_mean) base = i;
+#define MEDIAN_OF(field)                                                                           \
+  do {                                                                                             \
+    for (int i = 0; i < n; i++)                                                                    \
+      v[i] = runs[i].field;                                                                        \
+    runs[base].field = kth(v, n, mid);                                                             \
+  } while (0)
+    MEDIAN_OF(setup_s);
+    MEDIAN_OF(cut_factor);
+    MEDIAN_OF(step_max);
+    for (int i = 0; i < n; i++)
+      v[i] = runs[i].cut_max;
+    const double cut_max = kth(v, n, mid);
+    runs[base].cut_max_lo = v[0], runs[base].cut_max_hi = v[n - 1];
+    for (int i = 0; i < n; i++)
+      v[i] = runs[i].step_mean;
+    const double step_mean = kth(v, n, mid);
+    runs[base].step_mean_lo = v[0], runs[base].step_mean_hi = v[n - 1];
+    runs[base].cut_max = cut_max, runs[base].step_mean = step_mean;
+#undef MEDIAN_OF
+  }
+done:
+  for (int i = 0; i < n; i++)
+    if (i != base) free(runs[i].u);
+  *out = runs[base];
+  out->runs = n;
+  if (n == 1 || !out->ok)
+    out->cut_max_lo = out->cut_max_hi = out->cut_max,
+    out->step_mean_lo = out->step_mean_hi = out->step_mean;
+}
+
+/* Run one row: the defaults, then the interactive set when there is one, each o->repeat
+ * times, alternating. */
 static int run_row(const settings *o, const cutbench_model *m, const char *dir, cutbench_row *row)
 {
   const cutbench_paper *p = &cutbench_papers[row->id];
   const char *inter = o->interactive ? o->interactive : row_interactive[row->id];
+  const int sets = inter[0] ? 2 : 1, nrep = o->repeat;
   snprintf(row->interactive, sizeof row->interactive, "%s", inter);
   row->disp_diff = row->disp_max = -1.0;
-  int ok = 1;
-  for (int k = 0; k < (inter[0] ? 2 : 1); k++) {
-    char name[128], label[160];
+  cutbench_scene sc[2];
+  int written[2] = {0, 0}, nrun[2] = {0, 0}, ok = 1;
+  static cutbench_run runs[2][99];
+  for (int k = 0; k < sets; k++) {
+    char name[128];
     snprintf(name, sizeof name, "%s%s", p->row, k ? "-interactive" : "");
-    snprintf(label, sizeof label, "%s (%s)", p->row, k ? "interactive" : "defaults");
-    cutbench_scene sc;
-    if (!cutbench_write_scene(row->id, m, m->path, o->scale, k ? inter : "", dir, "cuts", name,
-                              &sc)) {
+    written[k] = cutbench_write_scene(row->id, m, m->path, o->scale, k ? inter : "", dir, "cuts",
+                                      name, &sc[k]);
+    if (!written[k]) {
       row->run[k].ran = 1;
       snprintf(row->run[k].note, sizeof row->run[k].note, "the scene could not be written");
       ok = 0;
-      continue;
     }
-    row->h = sc.h;
-    fprintf(stderr, PROG ": %s: h = %.4g m, %d steps, cuts before steps", label, sc.h, sc.steps);
-    for (int e = 0; e < sc.events; e++)
-      fprintf(stderr, " %d", sc.event_step[e]);
-    fprintf(stderr, "\n");
-    /* the program's own option sets may name keys this build lacks: skipped, said so */
-    run_scene(sc.json_path, sc.steps, label, k == 1 && !o->interactive, &row->run[k]);
-    if (!row->run[k].ok && !row->run[k].skipped) ok = 0;
+  }
+  for (int rep = 0; rep < nrep; rep++)
+    for (int k = 0; k < sets; k++) {
+      /* a set skipped or failed once is not run again */
+      if (!written[k] || (rep > 0 && (runs[k][0].skipped || !runs[k][rep - 1].ok))) continue;
+      char label[192];
+      if (nrep > 1)
+        snprintf(label, sizeof label, "%s (%s, run %d of %d)", p->row,
+                 k ? "interactive" : "defaults", rep + 1, nrep);
+      else
+        snprintf(label, sizeof label, "%s (%s)", p->row, k ? "interactive" : "defaults");
+      row->h = sc[k].h;
+      fprintf(stderr, PROG ": %s: h = %.4g m, %d steps, cuts before steps", label, sc[k].h,
+              sc[k].steps);
+      for (int e = 0; e < sc[k].events; e++)
+        fprintf(stderr, " %d", sc[k].event_step[e]);
+      fprintf(stderr, "\n");
+      /* the program's own option sets may name keys this build lacks: skipped, said so */
+      run_scene(sc[k].json_path, sc[k].steps, label, k == 1 && !o->interactive, &runs[k][rep]);
+      nrun[k]++;
+    }
+  for (int k = 0; k < sets; k++) {
+    if (!written[k]) continue;
+    if (runs[k][0].skipped)
+      row->run[k] = runs[k][0];
+    else
+      combine_runs(runs[k], nrun[k], &row->run[k]);
+    if (!row->run[k].ok && !row->run[k].skipped) {
+      ok = 0;
+      if (nrun[k] > 1) fprintf(stderr, PROG ": %s: %s\n", p->row, row->run[k].note);
+    }
   }
   const cutbench_run *a = &row->run[0], *b = &row->run[1];
   if (a->ok) {
@@ -431,10 +537,15 @@ static int bench_main(fcm_ctx *ctx, const settings *o)
     code = 1;
     goto done;
   }
-  printf("fcm-cutbench%s: body %s (%lld x %lld x %lld mm, %.4g l), sizes %g x the papers'\n",
+  printf("fcm-cutbench%s: body %s (%lld x %lld x %lld mm, %.4g l), sizes %g x the papers'",
          o->quick ? " --quick: the smallest row of each paper only" : "", m.name,
          (long long)lround(1e3 * (m.hi[0] - m.lo[0])), (long long)lround(1e3 * (m.hi[1] - m.lo[1])),
          (long long)lround(1e3 * (m.hi[2] - m.lo[2])), 1e3 * m.volume, o->scale);
+  if (o->repeat > 1)
+    printf("; each figure the median of %d runs, the largest cut's and the mean step's range "
+           "below each row",
+           o->repeat);
+  printf("\n");
   cutbench_print_header();
   for (int r = 0; r < ROW_COUNT; r++) {
     if (!o->selected[r]) continue;

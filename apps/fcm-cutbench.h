@@ -109,10 +109,13 @@ typedef struct cutbench_run {
   double cut_factor; /* the factorization (or the hierarchy's first set-up) of the step after
                         a cut, mean over the events */
   long long steps;
-  double step_mean, step_max; /* wall seconds of a step, the cuts before it excluded */
-  double newton, linear;      /* per step, mean */
-  double *u;                  /* the final displacement (malloc'd), for the comparison */
-  long long n;                /* its length */
+  double step_mean, step_max;        /* wall seconds of a step, the cuts before it excluded */
+  double newton, linear;             /* per step, mean */
+  double *u;                         /* the final displacement (malloc'd), for the comparison */
+  long long n;                       /* its length */
+  int runs;                          /* the runs the figures are the medians of (--repeat) */
+  double cut_max_lo, cut_max_hi;     /* the largest cut's range over the runs */
+  double step_mean_lo, step_mean_hi; /* the mean step's range over the runs */
 } cutbench_run;
 
 /** One row: the paper's figures, the default run and the interactive one (when an option set

@@ -6,10 +6,13 @@
  * the largest step; at least one Newton iteration per step; the ratios are fcm's figure over
  * the paper's and the verdicts follow from them; both runs of a row end on the same DOFs and
  * differ in displacement by less than a tenth of the largest displacement. The PNG is a PNG
- * (with gnuplot). --write-scenes writes scenes that parse. Bad options exit 2 and write no CSV.
- * Mode rows (label app): the rows left out of --quick — the accordion runs at 0.1 of its size
- * (both runs ok, every figure finite, its five cut events add DOFs, at least one Newton
- * iteration a step, the same DOFs in both runs); the plate's, accordion's and octopus's scenes
+ * (with gnuplot). --write-scenes writes scenes that parse. Bad options (--repeat outside [1, 99]
+ * among them) exit 2 and write no CSV.
+ * Every run's count of runs is 1 and its ranges its figures. Mode rows (label app): the rows
+ * left out of --quick — the accordion runs at 0.1 of its size, three times (--repeat 3: both
+ * option sets ok, every figure finite and inside its range over the three runs, which all
+ * ended alike; its five cut events add DOFs, at least one Newton iteration a step, the same
+ * DOFs in both sets); the plate's, accordion's and octopus's scenes
  * written with --write-scenes parse with their cut events.
  * Mode full (label bench): every row at the papers' sizes runs, the defaults ok, the program's
  * interactive sets ok or skipped (a build without their keys).
@@ -29,8 +32,9 @@
   "dofs_after,cut_events,cut_s_mean,cut_s_max,cut_rules_s,cut_space_s,cut_integrator_s,"           \
   "cut_solver_s,cut_other_s,cut_factor_s,setup_s,steps,step_s_mean,step_s_max,newton_per_step,"    \
   "linear_per_step,paper_cut_s,paper_step_s,paper_step_max_s,paper_machine,cut_ratio,step_ratio,"  \
-  "step_target_s,cut_ok,step_ok,disp_diff_m,disp_max_m,options,note\n"
-#define NCOL 40
+  "step_target_s,cut_ok,step_ok,disp_diff_m,disp_max_m,runs,cut_s_max_lo,cut_s_max_hi,"            \
+  "step_s_mean_lo,step_s_mean_hi,options,note\n"
+#define NCOL 45
 
 enum {
   C_ROW = 0,
@@ -65,7 +69,12 @@ enum {
   C_CUTOK,
   C_STEPOK,
   C_DIFF,
-  C_DMAX
+  C_DMAX,
+  C_RUNS,
+  C_CUTMAX_LO,
+  C_CUTMAX_HI,
+  C_STEP_LO,
+  C_STEP_HI
 };
 
 typedef struct crow {
@@ -92,6 +101,17 @@ static int read_rows(const char *path, crow *rows, int cap)
   }
   fclose(f);
   return n;
+}
+
+/* The runs' count and the ranges of the largest cut and the mean step: `runs` runs, each
+ * figure inside its range (a single run's range is the figure itself). */
+static void check_runs(const crow *r, double runs)
+{
+  TEST_TRUE(r->v[C_RUNS] == runs);
+  TEST_TRUE(r->v[C_CUTMAX_LO] <= r->v[C_CUTMAX] && r->v[C_CUTMAX] <= r->v[C_CUTMAX_HI]);
+  TEST_TRUE(r->v[C_STEP_LO] <= r->v[C_STEP] && r->v[C_STEP] <= r->v[C_STEP_HI]);
+  if (runs == 1.0)
+    TEST_TRUE(r->v[C_CUTMAX_LO] == r->v[C_CUTMAX_HI] && r->v[C_STEP_LO] == r->v[C_STEP_HI]);
 }
 
 /* Every measured figure of a run that went well. */
@@ -149,6 +169,8 @@ static void quick(const char *prog, const char *work)
     TEST_TRUE(!strcmp(d->f[C_SOLVER], "defaults") && !strcmp(q->f[C_SOLVER], "interactive"));
     check_run(d, events[i]);
     check_run(q, events[i]);
+    check_runs(d, 1.0);
+    check_runs(q, 1.0);
     TEST_TRUE(q->v[C_DOFS1] == d->v[C_DOFS1] && q->v[C_DOFS0] == d->v[C_DOFS0]);
     TEST_TRUE(d->v[C_DMAX] > 0.0 && isfinite(q->v[C_DIFF]) && q->v[C_DIFF] >= 0.0);
     TEST_TRUE(q->v[C_DIFF] <= 0.1 * d->v[C_DMAX]);
@@ -176,9 +198,14 @@ static void quick(const char *prog, const char *work)
   }
   fcm_ctx_destroy(&ctx);
   /* usage errors: exit 2, no CSV */
-  static const char *const bad[] = {
-      "--rows nope",  "--quick --rows dick-bunny3",    "--scale 0",
-      "--fill-holes", "--interactive '{\"rtol\": 1}'", "--model x.obj --surface-triangles 100"};
+  static const char *const bad[] = {"--rows nope",
+                                    "--quick --rows dick-bunny3",
+                                    "--scale 0",
+                                    "--fill-holes",
+                                    "--interactive '{\"rtol\": 1}'",
+                                    "--model x.obj --surface-triangles 100",
+                                    "--repeat 0",
+                                    "--repeat 100"};
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     remove(csv);
     snprintf(cmd, sizeof cmd, "'%s' %s --csv '%s' 2> /dev/null", prog, bad[k], csv);
@@ -216,8 +243,9 @@ static void rows_mode(const char *prog, const char *work)
   static crow rows[16];
   snprintf(csv, sizeof csv, "%s/cutbench-accordion.csv", work);
   remove(csv);
-  snprintf(cmd, sizeof cmd, "'%s' --rows tonthat-accordion --scale 0.1 --csv '%s' > /dev/null 2>&1",
-           prog, csv);
+  snprintf(cmd, sizeof cmd,
+           "'%s' --rows tonthat-accordion --scale 0.1 --repeat 3 --csv '%s' > /dev/null 2>&1", prog,
+           csv);
   TEST_TRUE(app_run(cmd) == 0);
   const int n = read_rows(csv, rows, 16);
   TEST_TRUE(n == 2);
@@ -227,6 +255,8 @@ static void rows_mode(const char *prog, const char *work)
     TEST_TRUE(!strcmp(d->f[C_SOLVER], "defaults") && !strcmp(q->f[C_SOLVER], "interactive"));
     check_run(d, 5);
     check_run(q, 5);
+    check_runs(d, 3.0);
+    check_runs(q, 3.0);
     TEST_TRUE(q->v[C_DOFS1] == d->v[C_DOFS1] && q->v[C_DOFS0] == d->v[C_DOFS0]);
     TEST_TRUE(d->v[C_DMAX] > 0.0 && isfinite(q->v[C_DIFF]));
   }
