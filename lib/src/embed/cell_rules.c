@@ -78,8 +78,19 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   /* 3. gather, 4. statistics */
   FCM_TRY(ctx, fcm__embed_gather_rules(ctx, R, out, prev));
   if (B.cut_tree) FCM_TRY(ctx, fcm__embed_gather_links(&B, R, out));
-  if (B.cut_tree) FCM_TRY(ctx, fcm__embed_keep_face_polygons(&B, R, out));
-  fcm__embed_gather_stats(R, geom, out, &sums, nthreads);
+  {
+    /* the kept face polygons (which move out of the cells' outputs) and the statistics (which
+     * read the outputs' other fields and allocate nothing) side by side */
+    fcm_status kept = FCM_OK;
+#pragma omp parallel sections num_threads(2) if (B.cut_tree && nthreads > 1)
+    {
+#pragma omp section
+      if (B.cut_tree) kept = fcm__embed_keep_face_polygons(&B, R, out);
+#pragma omp section
+      fcm__embed_gather_stats(R, geom, out, &sums, nthreads);
+    }
+    FCM_TRY(ctx, kept);
+  }
   FCM_TRY(ctx, fcm__embed_outside(ctx, mesh, geom, &R->stats));
   if (o->simplify != FCM_CELL_SIMPLIFY_AUTO)
     for (int k = 0; k < FCM_RULE_KIND_COUNT; k++)

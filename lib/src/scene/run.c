@@ -441,7 +441,7 @@ cleanup:
 /* The parts of a cut's work on the cut space, as iterations of loop L (their order the order
  * of the errors reported): the new integrator's values (fcm__integrator_cut_values()), the
  * linear solver's structure (fcm__integrator_cut_structure()), the output surface split
- * again, the log's mass blocks. */
+ * again, the log's mass blocks and the space's bodies. */
 enum { CUT_VALUES, CUT_STRUCTURE, CUT_SURFACE, CUT_LOG_BLOCKS, CUT_PARTS };
 
 static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space *space,
@@ -457,8 +457,8 @@ static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space 
     st = fcm__integrator_cut_structure(cut);
   else if (part == CUT_SURFACE)
     st = S->surf ? fcm_embedded_surface_set_space(S->surf, space) : FCM_OK;
-  else
-    st = keep_log_blocks(S, space);
+  else if ((st = keep_log_blocks(S, space)) == FCM_OK)
+    S->cut_pieces = fcm_space_num_bodies(space);
   fcm__loop_leave(L, &it, st);
 }
 
@@ -470,9 +470,9 @@ static void cut_part(fcm_simulation *S, fcm__loop *L, int part, const fcm_space 
  * them. None reads what another writes (the structure reads the new integrator's pattern and
  * constraints' DOFs, which the first stage wrote, and old's hierarchy; the values the old
  * integrator and the new space; the surface the new space, its rules and the geometry; the
- * log's blocks the two spaces' elements and mass caches, which only they write), and each
- * gives the bits it gives alone (the loops inside run on one thread then, and give the bits
- * they give on two). A distributed run makes them on the calling thread in turn. A failed
+ * log's blocks and bodies the two spaces' elements and mass caches, which only they write),
+ * and each gives the bits it gives alone (the loops inside run on one thread then, and give
+ * the bits they give on two). A distributed run makes them on the calling thread in turn. A failed
  * part gives the storage back to the old integrator, which goes on. The structure leaves
  * level 0's smoothers to a task (fcm__integrator_cut's `beside`), which the thread that
  * reaches the team's barrier first runs, and which is completed after the barrier as part
@@ -586,7 +586,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   integ = NULL, space = NULL, rules = NULL;
   S->c.num_dofs = fcm_space_num_dofs(S->space);
   S->c.constrained_dofs = fcm_integrator_num_constrained(S->integ);
-  S->pieces = fcm_space_num_bodies(S->space);
+  S->pieces = S->cut_pieces;
   S->c.pieces = S->pieces;
   FCM_TRY(ctx, build_log_blocks(S));
 cleanup:

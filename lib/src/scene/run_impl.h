@@ -108,7 +108,8 @@ struct fcm_simulation {
   /* cuts whose integrator and output surface were made on two threads; 1 in cuts_in_turn: one
    * after the other on every thread (the sequence the tests compare with) */
   int cuts_side_by_side, cuts_in_turn;
-  fcm_index pieces; /* separate bodies of the current space (fcm_space_num_bodies()) */
+  fcm_index pieces;     /* separate bodies of the current space (fcm_space_num_bodies()) */
+  fcm_index cut_pieces; /* those of a cut's space, counted by its parts (cut_part()) */
   long long base_factorizations, base_analyses, base_fallbacks; /* of integrators before cuts */
   /* "octree": {"cuts": {"when": "cut"}}: the refinement along the cuts done when the first cut
    * applied: the time, the cells before and after, the wall time (refined 0: not yet) */
