@@ -271,4 +271,16 @@ static inline fcm_index fcm__lower_bound(const fcm_index *a, fcm_index stride, f
   return lo;
 }
 
+/* a[0..n) ascending by insertion (a few entries). */
+static inline void fcm__insertion_sort(fcm_index *a, fcm_index n)
+{
+  for (fcm_index i = 1; i < n; i++) {
+    const fcm_index v = a[i];
+    fcm_index j = i;
+    for (; j > 0 && a[j - 1] > v; j--)
+      a[j] = a[j - 1];
+    a[j] = v;
+  }
+}
+
 #endif /* FCM_CORE_IMPL_H */
