@@ -71,13 +71,9 @@ static void arguments(fcm_ctx *ctx)
 
 static void allocation_failures(void)
 {
-  failing f = {0, -1};
-  fcm_ctx_options co = fcm_ctx_options_default();
-  co.allocator.alloc = failing_alloc;
-  co.allocator.release = failing_release;
-  co.allocator.user = &f;
-  fcm_ctx *ctx = NULL;
-  TEST_OK(NULL, fcm_ctx_create(&co, &ctx));
+  failing f;
+  fcm_ctx *ctx = failing_ctx(&f);
+  TEST_TRUE(ctx != NULL);
   if (!ctx) return;
   const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c0[3] = {0.1, 0, 0};
   const fcm_index n[3] = {2, 2, 1};
@@ -158,13 +154,10 @@ static void *poisoned_alloc(void *user, size_t size)
 
 static void cut_allocation_failures(void)
 {
-  failing f = {0, -1};
-  fcm_ctx_options co = fcm_ctx_options_default();
-  co.allocator.alloc = poisoned_alloc; /* what is read before it is written is garbage */
-  co.allocator.release = failing_release;
-  co.allocator.user = &f;
-  fcm_ctx *ctx = NULL;
-  TEST_OK(NULL, fcm_ctx_create(&co, &ctx));
+  failing f;
+  /* what is read before it is written is garbage */
+  fcm_ctx *ctx = failing_ctx_with(&f, poisoned_alloc);
+  TEST_TRUE(ctx != NULL);
   if (!ctx) return;
   TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1)); /* the failing allocator's counter is not atomic */
   const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c0[3] = {0.07, -0.03, 0.02};

@@ -41,13 +41,9 @@ done:
 
 int main(void)
 {
-  failing f = {0, -1};
-  fcm_ctx_options o = fcm_ctx_options_default();
-  o.allocator.alloc = failing_alloc;
-  o.allocator.release = failing_release;
-  o.allocator.user = &f;
-  fcm_ctx *ctx = NULL;
-  TEST_OK(ctx, fcm_ctx_create(&o, &ctx));
+  failing f;
+  fcm_ctx *ctx = failing_ctx(&f);
+  TEST_TRUE(ctx != NULL);
   TEST_TRUE(vr_mkdir(DIR));
 
   long long k = 0;

@@ -57,13 +57,9 @@ static fcm_status residual_round(void *user)
 
 int main(void)
 {
-  failing f = {0, -1};
-  fcm_ctx_options opts = fcm_ctx_options_default();
-  opts.allocator.alloc = failing_alloc;
-  opts.allocator.release = failing_release;
-  opts.allocator.user = &f;
-  rule_case c = {NULL, 0, 0, FCM_SHAPE_LINE, NULL, 0.0};
-  TEST_OK(c.ctx, fcm_ctx_create(&opts, &c.ctx));
+  failing f;
+  rule_case c = {failing_ctx(&f), 0, 0, FCM_SHAPE_LINE, NULL, 0.0};
+  TEST_TRUE(c.ctx != NULL);
   if (!c.ctx) return TEST_RESULT();
 
   /* rule struct, points, weights at least: 3 failing rounds */

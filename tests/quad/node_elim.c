@@ -210,12 +210,9 @@ int main(void)
   fcm_ctx_destroy(&ctx);
 
   /* allocation failure: fail the k-th allocation until the call succeeds */
-  failing f = {0, -1};
-  fcm_ctx_options co = fcm_ctx_options_default();
-  co.allocator.alloc = failing_alloc;
-  co.allocator.release = failing_release;
-  co.allocator.user = &f;
-  TEST_OK(ctx, fcm_ctx_create(&co, &ctx));
+  failing f;
+  ctx = failing_ctx(&f);
+  TEST_TRUE(ctx != NULL);
   if (!ctx) return TEST_RESULT();
   TEST_OK(ctx, fcm_rule_create_computed(ctx, FCM_SHAPE_TRI, 4, &start));
   int succeeded = 0;

@@ -62,15 +62,11 @@ static fcm_status sim_round(void *user)
 
 int main(void)
 {
-  failing f = {0, -1};
-  fcm_ctx_options co = fcm_ctx_options_default();
-  co.allocator.alloc = failing_alloc;
-  co.allocator.release = failing_release;
-  co.allocator.user = &f;
-  fcm_ctx *ctx = NULL;
+  failing f;
+  fcm_ctx *ctx = failing_ctx(&f);
   fcm_mesh *mesh = NULL;
   fcm_space *space = NULL;
-  TEST_OK(ctx, fcm_ctx_create(&co, &ctx));
+  TEST_TRUE(ctx != NULL);
   TEST_OK(ctx, beam_mesh(ctx, FCM_ELEMENT_HEX8, 2, 2.0, &mesh));
   TEST_OK(ctx, fcm_space_create(ctx, mesh, NULL, &space));
   fcm_index nfix = 0;

@@ -35,13 +35,9 @@ static fcm_status simplify_round(void *user)
 
 int main(void)
 {
-  failing f = {0, -1};
-  fcm_ctx_options opts = fcm_ctx_options_default();
-  opts.allocator.alloc = failing_alloc;
-  opts.allocator.release = failing_release;
-  opts.allocator.user = &f;
-  fcm_ctx *ctx = NULL;
-  TEST_OK(ctx, fcm_ctx_create(&opts, &ctx));
+  failing f;
+  fcm_ctx *ctx = failing_ctx(&f);
+  TEST_TRUE(ctx != NULL);
   if (!ctx) return TEST_RESULT();
 
   const int m = 2, M = util_num_basis(m), n = 9 * M; /* two recombination rounds */

@@ -255,4 +255,32 @@ fcm_status fcm__loop_end(fcm__loop *loop, fcm_index *failed);
 #define FCM_MIN(a, b) ((a) < (b) ? (a) : (b))
 #define FCM_MAX(a, b) ((a) > (b) ? (a) : (b))
 
+/* The first i in [lo, hi) with a[stride * i] >= key, hi when none: a lower-bound bisection
+ * over a[stride * lo], ..., a[stride * (hi - 1)] ascending (stride 1: a sorted list; 2: pairs
+ * sorted by their first entries). */
+static inline fcm_index fcm__lower_bound(const fcm_index *a, fcm_index stride, fcm_index lo,
+                                         fcm_index hi, fcm_index key)
+{
+  while (lo < hi) {
+    const fcm_index mid = lo + (hi - lo) / 2;
+    if (a[stride * mid] < key)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* a[0..n) ascending by insertion (a few entries). */
+static inline void fcm__insertion_sort(fcm_index *a, fcm_index n)
+{
+  for (fcm_index i = 1; i < n; i++) {
+    const fcm_index v = a[i];
+    fcm_index j = i;
+    for (; j > 0 && a[j - 1] > v; j--)
+      a[j] = a[j - 1];
+    a[j] = v;
+  }
+}
+
 #endif /* FCM_CORE_IMPL_H */

@@ -335,15 +335,8 @@ static fcm_status copy_links(const build *B, const fcm_cell_rules *R, fcm_index 
   fcm_status st = FCM_OK;
   const fcm_cell_rules *Q = B->prev;
   const fcm_index qa0 = Q->piece_off[ca], qb0 = Q->piece_off[cb], qb1 = Q->piece_off[cb + 1];
-  fcm_index lo = 0, hi = Q->num_links; /* the first link from a piece of ca */
-  while (lo < hi) {
-    const fcm_index mid = lo + (hi - lo) / 2;
-    if (Q->links[2 * mid] < qa0)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  for (fcm_index l = lo; l < Q->num_links && Q->links[2 * l] < Q->piece_off[ca + 1]; l++) {
+  const fcm_index l0 = fcm__lower_bound(Q->links, 2, 0, Q->num_links, qa0); /* ca's first */
+  for (fcm_index l = l0; l < Q->num_links && Q->links[2 * l] < Q->piece_off[ca + 1]; l++) {
     const fcm_index qa = Q->links[2 * l], qb = Q->links[2 * l + 1];
     if (qb < qb0 || qb >= qb1) continue;
     FCM_TRY(B->ctx, push_link(B->ctx, R->piece_off[ca] + (qa - qa0), R->piece_off[cb] + (qb - qb0),

@@ -187,6 +187,18 @@ typedef struct fcm__embed_counts {
   fcm_index kept;              /* cells a cut reaches whose pieces it leaves unchanged */
 } fcm__embed_counts;
 
+/* Add one cell's fcm__embed_append_tets() results (tets kept, slivers dropped and their volume,
+ * volume moved) to counts (may be NULL). */
+static inline void fcm__embed_counts_add_tets(fcm__embed_counts *counts, size_t tets,
+                                              fcm_index slivers, double lost, double moved)
+{
+  if (!counts) return;
+  counts->tets += (fcm_index)tets;
+  counts->slivers += slivers;
+  counts->sliver_volume += lost;
+  counts->moved_volume += moved;
+}
+
 /* ---------------------------------------------------------------- distributed classification */
 
 /* A rules build whose classification is shared among processes (the PETSc adapter, with a

@@ -229,11 +229,8 @@ fcm_status fcm__embed_cell_tets(fcm_ctx *ctx, const fcm_geometry *geom, const fc
   if (counts) {
     counts->candidates += (fcm_index)ws->cand.n;
     counts->parts += nparts;
-    counts->tets += (fcm_index)ws->num_tets;
-    counts->slivers += nslivers;
-    counts->sliver_volume += lost;
-    counts->moved_volume += moved;
   }
+  fcm__embed_counts_add_tets(counts, ws->num_tets, nslivers, lost, moved);
   *volume = vsum;
 cleanup:
   return st;

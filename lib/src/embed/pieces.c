@@ -789,12 +789,7 @@ fcm_status fcm__embed_piece_tets(fcm_ctx *ctx, const fcm__parts *P, const int *l
     if (label[i] == piece)
       FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, P->poly + i, P->vmin[i], &vsum, &lost, &moved,
                                           &nslivers));
-  if (counts) {
-    counts->tets += (fcm_index)ws->num_tets;
-    counts->slivers += nslivers;
-    counts->sliver_volume += lost;
-    counts->moved_volume += moved;
-  }
+  fcm__embed_counts_add_tets(counts, ws->num_tets, nslivers, lost, moved);
   *volume = vsum;
 cleanup:
   return st;

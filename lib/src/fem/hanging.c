@@ -127,15 +127,7 @@ static void around_join(const fcm_space *s, around *A)
   const fcm_index *links = fcm_cell_rules_links(s->rules);
   for (fcm_index i = 0; i < A->n; i++) {
     const fcm_index p = s->elem_piece[A->el[i]];
-    fcm_index lo = 0, hi = nl;
-    while (lo < hi) {
-      const fcm_index mid = lo + (hi - lo) / 2;
-      if (links[2 * mid] < p)
-        lo = mid + 1;
-      else
-        hi = mid;
-    }
-    for (fcm_index l = lo; l < nl && links[2 * l] == p; l++) {
+    for (fcm_index l = fcm__lower_bound(links, 2, 0, nl, p); l < nl && links[2 * l] == p; l++) {
       const fcm_index q = links[2 * l + 1], cq = fcm_cell_rules_piece_cell(s->rules, q);
       fcm_index fq = 0;
       fcm_cell_rules_cell_pieces(s->rules, cq, &fq);

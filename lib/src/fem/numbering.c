@@ -98,14 +98,7 @@ static fcm_index uf_find(fcm_index *uf, fcm_index a)
 /* The position of element e in the ascending list sup[0..deg) (a node's support), -1: none. */
 static fcm_index support_pos(const fcm_index *sup, fcm_index deg, fcm_index e)
 {
-  fcm_index lo = 0, hi = deg;
-  while (lo < hi) {
-    const fcm_index mid = lo + (hi - lo) / 2;
-    if (sup[mid] < e)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
+  const fcm_index lo = fcm__lower_bound(sup, 1, 0, deg, e);
   return lo < deg && sup[lo] == e ? lo : -1;
 }
 

@@ -370,14 +370,7 @@ fcm_index fcm__space_elem_local(const fcm_space *s, fcm_index e)
 {
   if (e < 0 || e >= s->num_elems) return -1;
   if (!s->local_elem) return s->is_local ? -1 : e; /* a local space without local elements */
-  fcm_index lo = 0, hi = s->num_local_elems;
-  while (lo < hi) {
-    const fcm_index mid = lo + (hi - lo) / 2;
-    if (s->local_elem[mid] < e)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
+  const fcm_index lo = fcm__lower_bound(s->local_elem, 1, 0, s->num_local_elems, e);
   return (lo < s->num_local_elems && s->local_elem[lo] == e) ? lo : -1;
 }
 

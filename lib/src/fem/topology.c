@@ -28,13 +28,7 @@ void fcm__space_sort_indices(fcm_index *list, fcm_index n)
     qsort(list, (size_t)n, sizeof *list, cmp_index);
     return;
   }
-  for (fcm_index i = 1; i < n; i++) {
-    const fcm_index v = list[i];
-    fcm_index j = i;
-    for (; j > 0 && list[j - 1] > v; j--)
-      list[j] = list[j - 1];
-    list[j] = v;
-  }
+  fcm__insertion_sort(list, n);
 }
 
 /* Copy -> elements incidence over the local topology: for each of the num_local_copies copies,

@@ -187,18 +187,6 @@ static inline int probe_meets(const probe *q, const double *blo, const double *b
   return 1;
 }
 
-/* ids[0..n) ascending by insertion (few ids). */
-static void insertion_sort(fcm_index *ids, size_t n)
-{
-  for (size_t i = 1; i < n; i++) {
-    const fcm_index v = ids[i];
-    size_t j = i;
-    for (; j > 0 && ids[j - 1] > v; j--)
-      ids[j] = ids[j - 1];
-    ids[j] = v;
-  }
-}
-
 /* The ids ascending (distinct ids: any sort gives the same order), without qsort's call per
  * comparison: a quicksort on the median of three, insertion below 24 ids, qsort for a range
  * that went deeper than twice log2 n (no quadratic case). */
@@ -238,7 +226,7 @@ static void sort_ids(fcm_index *ids, size_t n)
       n = left;
     }
   }
-  insertion_sort(ids, n);
+  fcm__insertion_sort(ids, (fcm_index)n);
 }
 
 /* The items whose boxes q meets, ascending, into buf. Children are tested before they are

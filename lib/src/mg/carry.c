@@ -62,15 +62,7 @@ static const fcm_space *level0_graph(const fcm_mg *m)
 /* The first place in copy k's graph row whose copy is not below k (k's own, if it is there). */
 static fcm_index own_slot(const fcm_space *sp, fcm_index k)
 {
-  fcm_index lo = sp->node_ptr[k], hi = sp->node_ptr[k + 1];
-  while (lo < hi) {
-    const fcm_index mid = lo + (hi - lo) / 2;
-    if (sp->node_adj[mid] < k)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  return lo;
+  return fcm__lower_bound(sp->node_adj, 1, sp->node_ptr[k], sp->node_ptr[k + 1], k);
 }
 
 int fcm__mg_space_triples(const fcm_mg *m, unsigned char *triple)

@@ -93,13 +93,7 @@ static fcm_status graph_from_edges(fcm_ctx *ctx, fcm_index ncell, fcm_index nedg
   fcm_index out = 0;
   for (fcm_index c = 0; c < ncell; c++) {
     const fcm_index s = ptr[c], e = ptr[c + 1];
-    for (fcm_index i = s + 1; i < e; i++) { /* a few neighbours: insertion sort */
-      const fcm_index v = adj[i];
-      fcm_index j = i;
-      for (; j > s && adj[j - 1] > v; j--)
-        adj[j] = adj[j - 1];
-      adj[j] = v;
-    }
+    fcm__insertion_sort(adj + s, e - s); /* a few neighbours */
     ptr[c] = out;
     for (fcm_index i = s; i < e; i++)
       if (i == s || adj[i] != adj[i - 1]) adj[out++] = adj[i];

@@ -611,15 +611,7 @@ cleanup:
 /* The first pair of coarse node `node` (np when none). */
 static fcm_index first_pair(const fcm_index *pairs, fcm_index np, fcm_index node)
 {
-  fcm_index lo = 0, hi = np;
-  while (lo < hi) {
-    const fcm_index mid = lo + (hi - lo) / 2;
-    if (pairs[2 * mid] < node)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
-  return lo;
+  return fcm__lower_bound(pairs, 2, 0, np, node);
 }
 
 /* The coarse level's cells for its statistics (fcm_mg_get_level_info(): bodies): one per

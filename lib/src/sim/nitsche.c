@@ -545,13 +545,7 @@ double fcm_integrator_boundary_penalty(const fcm_integrator *I, fcm_index elem)
 {
   if (!I || !I->bp.gamma || elem < 0 || elem >= I->space->num_elems) return 0.0;
   const sim_bpoints *bp = &I->bp;
-  fcm_index lo = 0, hi = bp->nelem; /* elements with points are sorted */
-  while (lo < hi) {
-    const fcm_index mid = lo + (hi - lo) / 2;
-    if (bp->elem[mid] < elem)
-      lo = mid + 1;
-    else
-      hi = mid;
-  }
+  /* elements with points are sorted */
+  const fcm_index lo = fcm__lower_bound(bp->elem, 1, 0, bp->nelem, elem);
   return lo < bp->nelem && bp->elem[lo] == elem ? element_max_penalty(I, lo) : 0.0;
 }
