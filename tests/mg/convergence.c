@@ -70,6 +70,9 @@ int main(int argc, char **argv)
     if (getenv("FCM_TEST_MG_BLOCK_SWEEP")) o.block_sweep = atoi(getenv("FCM_TEST_MG_BLOCK_SWEEP"));
     /* the one-way pointwise sweeps */
     if (getenv("FCM_TEST_MG_POINT_SWEEP")) o.point_sweep = atoi(getenv("FCM_TEST_MG_POINT_SWEEP"));
+    /* the finest level's blocks only at the cells with a small piece */
+    if (getenv("FCM_TEST_MG_BLOCK_FRACTION"))
+      o.block_fraction = atof(getenv("FCM_TEST_MG_BLOCK_FRACTION"));
     fcm_mg *mg = NULL;
     TEST_OK(ctx, fcm_mg_create(ctx, p.space, p.A, &o, &mg));
     if (!mg) {

@@ -44,6 +44,12 @@ set_tests_properties(mg_convergence_cut_pointway PROPERTIES
 fcm_add_test(mg_convergence_cut_vertex_oneway tests/mg/convergence.c ARGS cut 8 16)
 set_tests_properties(mg_convergence_cut_vertex_oneway PROPERTIES
                      ENVIRONMENT "FCM_TEST_MG_BLOCKS=1;FCM_TEST_MG_BLOCK_SWEEP=1")
+# the finest level's blocks only at cells with a small piece (Dick's interactive set's 0.5)
+fcm_add_test(mg_convergence_cut_fraction tests/mg/convergence.c ARGS cut 8 16)
+set_tests_properties(mg_convergence_cut_fraction PROPERTIES
+                     ENVIRONMENT
+                     "FCM_TEST_MG_BLOCKS=2;FCM_TEST_MG_BLOCK_SWEEP=1;FCM_TEST_MG_POINT_SWEEP=1;FCM_TEST_MG_BLOCK_FRACTION=0.5")
+fcm_add_test(mg_block_fraction tests/mg/block_fraction.c)
 fcm_add_test(mg_smooth_paths tests/mg/smooth_paths.c)
 fcm_add_test(mg_block_apply tests/mg/block_apply.c)
 # the coarser levels' values every coarse_interval-th set-up, then those of a fresh hierarchy

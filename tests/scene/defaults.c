@@ -22,6 +22,7 @@ static void same_mg(const fcm_mg_options *a, const fcm_mg_options *b)
   SAME(a, b, coarse_dofs);
   SAME(a, b, block_smoothing);
   SAME(a, b, blocks);
+  SAME(a, b, block_fraction);
   SAME(a, b, block_sweep);
   SAME(a, b, point_sweep);
   SAME(a, b, coarse_interval);

@@ -96,6 +96,11 @@ typedef struct fcm_mg_options {
                                  (the Hex20 V-cycle stalls near 0.95 without it, the hollow
                                  ball's grows with n); 0: pointwise smoothing only */
   fcm_mg_blocks blocks;     /**< the finest level's blocks (default FCM_MG_BLOCKS_ALL) */
+  double block_fraction;    /**< the finest level's blocks only at the cut cells one of whose
+                                 pieces holds less than this fraction of the cell (the cells
+                                 whose basis functions a small support makes nearly dependent;
+                                 a piece filling much of its cell is smoothed pointwise well
+                                 enough); in (0, 1], default 1: every cut cell */
   int block_sweep;          /**< 0 (default): each block smoothing is a symmetric block
                                  Gauss-Seidel sweep (forward, then backward); 1: one way,
                                  forward before the coarse correction and backward after it

@@ -37,6 +37,7 @@ fcm_mg_options fcm_mg_options_default(void)
   o.coarse_dofs = 2000;
   o.block_smoothing = 1;
   o.blocks = FCM_MG_BLOCKS_ALL;
+  o.block_fraction = 1.0;
   o.block_sweep = 0;
   o.point_sweep = 0;
   o.coarse_interval = 1;
@@ -259,6 +260,8 @@ static fcm_status check_options(fcm_ctx *ctx, const fcm_mg_options *opts, fcm_mg
             (long long)o.coarse_dofs);
   FCM_CHECK(o.blocks >= 0 && o.blocks < FCM_MG_BLOCKS_COUNT, ctx, FCM_ERR_ARG,
             "mg_create: blocks = %d is not a fcm_mg_blocks", (int)o.blocks);
+  FCM_CHECK(isfinite(o.block_fraction) && o.block_fraction > 0.0 && o.block_fraction <= 1.0, ctx,
+            FCM_ERR_ARG, "mg_create: block_fraction = %g outside (0, 1]", o.block_fraction);
   FCM_CHECK(o.block_sweep == 0 || o.block_sweep == 1, ctx, FCM_ERR_ARG,
             "mg_create: block_sweep = %d is neither 0 (symmetric) nor 1 (one way)", o.block_sweep);
   FCM_CHECK(o.point_sweep == 0 || o.point_sweep == 1, ctx, FCM_ERR_ARG,

@@ -4,6 +4,7 @@
  * Prenter et al. 2020), and the check of the orders. The sweeps themselves: sweeps.c. */
 #include "mg/levels_impl.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -493,6 +494,38 @@ cleanup:
  * spaces level 0's blocks take the masters of their hanging DOFs (blocks_masters()), and the
  * octree levels of a cut space the images of the finer blocks (blocks_image()). */
 /* Level 0: the vertex blocks, then the element blocks of the cut cells. */
+/* The cut cells that get the finest level's blocks (m->opts.block_fraction): those one of whose
+ * pieces holds less than that fraction of the cell (its pieces' volumes against the cell's,
+ * the material's volume over its fraction); every cut cell at 1, or without the rules. *out:
+ * m->cut_cell itself, or an array of the caller's to free. */
+static fcm_status block_cells(const fcm_mg *m, unsigned char **out)
+{
+  fcm_status st = FCM_OK;
+  const fcm_cell_rules *R = fcm_space_cell_rules(m->space);
+  const double theta = m->opts.block_fraction;
+  *out = m->cut_cell;
+  if (theta >= 1.0 || !R) return FCM_OK;
+  const fcm_index nc = fcm_mesh_num_cells(fcm_space_mesh(m->space));
+  unsigned char *sel = NULL;
+  FCM_ALLOC(m->ctx, (size_t)nc + 1, sel);
+  for (fcm_index c = 0; c < nc; c++) {
+    if (!m->cut_cell[c]) continue;
+    fcm_index p0 = 0;
+    const fcm_index np = fcm_cell_rules_cell_pieces(R, c, &p0);
+    double total = 0.0, least = HUGE_VAL;
+    for (fcm_index q = p0; q < p0 + np; q++) {
+      const double v = fcm_cell_rules_piece_volume(R, q);
+      total += v, least = fmin(least, v);
+    }
+    const double fraction = fcm_cell_rules_volume_fraction(R, c);
+    /* least / |K| < theta, |K| = total / fraction; a cell without pieces keeps its blocks */
+    sel[c] = (unsigned char)(np == 0 || !(total > 0.0) || least * fraction < theta * total);
+  }
+  *out = sel;
+cleanup:
+  return st;
+}
+
 static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_out,
                                 fcm_index **dofs_out)
 {
@@ -505,11 +538,12 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
   const fcm_index *cells = fcm_mesh_cells(mesh), nnode = fcm_mesh_num_nodes(mesh);
   const fcm_index ne = fcm_space_num_elements(sp);
   fcm_index nb = 0, np = 0, nu = 0, neb = 0, ned = 0, *ptr = NULL, *dofs = NULL, *pairs = NULL;
-  unsigned char *mark = NULL;
+  unsigned char *mark = NULL, *sel = NULL;
+  FCM_TRY(ctx, block_cells(m, &sel));
   FCM_ALLOC(ctx, nnode + 1, mark);
   for (fcm_index e = 0; e < ne; e++) {
     const fcm_index c = fcm_space_element_cell(sp, e);
-    if (!m->cut_cell[c]) continue;
+    if (!sel[c]) continue;
     for (int a = 0; a < 8; a++)
       mark[cells[(fcm_index)npc * c + a]] = 1;
   }
@@ -533,7 +567,7 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
   for (fcm_index i = 0; i < nu; i++)
     nb += i == 0 || pairs[2 * i] != pairs[2 * i - 2];
   if (m->opts.blocks != FCM_MG_BLOCKS_VERTEX)
-    FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, NULL, NULL));
+    FCM_TRY(ctx, fcm_space_cell_blocks(sp, sel, &neb, &ned, NULL, NULL));
   FCM_ALLOC(ctx, nb + neb + 1, ptr);
   FCM_ALLOC(ctx, 3 * nu + ned + 1, dofs);
   for (fcm_index i = 0, k = 0; i < nu; i++) {
@@ -543,7 +577,7 @@ static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_ou
   }
   ptr[nb] = 3 * nu;
   if (neb > 0) {
-    FCM_TRY(ctx, fcm_space_cell_blocks(sp, m->cut_cell, &neb, &ned, ptr + nb, dofs + 3 * nu));
+    FCM_TRY(ctx, fcm_space_cell_blocks(sp, sel, &neb, &ned, ptr + nb, dofs + 3 * nu));
     for (fcm_index k = nb; k <= nb + neb; k++) /* offsets after the vertex blocks */
       ptr[k] += 3 * nu;
   }
@@ -556,6 +590,7 @@ cleanup:
   fcm__free(ctx, dofs);
   fcm__free(ctx, pairs);
   fcm__free(ctx, mark);
+  if (sel != m->cut_cell) fcm__free(ctx, sel);
   return st;
 }
 

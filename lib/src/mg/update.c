@@ -49,8 +49,8 @@ int fcm__mg_reuse_allowed(const fcm_mg *old, const fcm_mg *m)
          a->post_smooth == b->post_smooth && a->cycle_index == b->cycle_index &&
          a->max_levels == b->max_levels && a->coarse_dofs == b->coarse_dofs &&
          a->block_smoothing == b->block_smoothing && a->blocks == b->blocks &&
-         a->block_sweep == b->block_sweep && a->point_sweep == b->point_sweep &&
-         a->coarse_interval == b->coarse_interval;
+         a->block_fraction == b->block_fraction && a->block_sweep == b->block_sweep &&
+         a->point_sweep == b->point_sweep && a->coarse_interval == b->coarse_interval;
 }
 
 int fcm__mg_level_same(const fcm_mg *old, const fcm_mg *m, int l)

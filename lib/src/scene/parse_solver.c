@@ -86,9 +86,10 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
                                  fcm_integrator_options *s)
 {
   fcm_status st = FCM_OK;
-  static const char *const keys[] = {"smoother",    "omega",       "pre_smooth",      "post_smooth",
-                                     "cycle",       "coarse_dofs", "block_smoothing", "blocks",
-                                     "block_sweep", "point_sweep", "coarse_interval"};
+  static const char *const keys[] = {"smoother",        "omega",       "pre_smooth",
+                                     "post_smooth",     "cycle",       "coarse_dofs",
+                                     "block_smoothing", "blocks",      "block_fraction",
+                                     "block_sweep",     "point_sweep", "coarse_interval"};
   fcm_mg_options *m = &s->multigrid;
   size_t old = SCENE_ENTER(p, "multigrid");
   long long coarse = (long long)m->coarse_dofs;
@@ -112,6 +113,8 @@ static fcm_status read_multigrid(fcm__scene_parser *p, const fcm__json *mg,
   m->coarse_dofs = (fcm_index)coarse;
   FCM_TRY(p->ctx, fcm__scene_read_bool(p, mg, "block_smoothing", 0, &m->block_smoothing));
   SCENE_READ_CHOICE_AS(p, mg, "blocks", 0, blocks_names, blocks_values, m->blocks);
+  FCM_TRY(p->ctx, fcm__scene_read_number(p, mg, "block_fraction", 0, (fcm__range){0.0, 1.0, 1, 0},
+                                         &m->block_fraction));
   SCENE_READ_CHOICE_AS(p, mg, "block_sweep", 0, block_sweep_names, block_sweep_values,
                        m->block_sweep);
   SCENE_READ_CHOICE_AS(p, mg, "point_sweep", 0, block_sweep_names, block_sweep_values,

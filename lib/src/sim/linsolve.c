@@ -260,6 +260,9 @@ fcm_status fcm__sim_multigrid_validate(fcm_ctx *ctx, const fcm_integrator_option
   FCM_CHECK(m->cycle_index == 1 || m->cycle_index == 2, ctx, FCM_ERR_ARG,
             "integrator: multigrid.cycle_index = %d is neither 1 (V-cycle) nor 2 (W-cycle)",
             m->cycle_index);
+  FCM_CHECK(isfinite(m->block_fraction) && m->block_fraction > 0.0 && m->block_fraction <= 1.0, ctx,
+            FCM_ERR_ARG, "integrator: multigrid.block_fraction = %g outside (0, 1]",
+            m->block_fraction);
   FCM_CHECK(m->max_levels >= 1 && m->max_levels <= 32, ctx, FCM_ERR_ARG,
             "integrator: multigrid.max_levels = %d outside [1, 32]", m->max_levels);
   FCM_CHECK(m->coarse_dofs >= 1, ctx, FCM_ERR_ARG,
