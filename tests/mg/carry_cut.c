@@ -13,7 +13,8 @@
  * left to a task that the other thread may run, completed by fcm__mg_join() after the barrier)
  * the carry is the same hierarchy, and its allocation failures, in either part, are reported
  * (by the creation or the join) and leak nothing. The embedded hemisphere of mg_util.h, Hex8
- * and Hex20, V- and W-cycles. */
+ * and Hex20, V- and W-cycles (the W-cycle's finest blocks only at the cells with a piece under
+ * half the cell: fcm_mg_options.block_fraction 0.5). */
 #include "fem/fem_impl.h"
 #include "mg/levels_impl.h"
 #include "mg_compare.h"
@@ -369,6 +370,7 @@ static void cut_sequence(fcm_ctx *ctx, fcm_element_type type)
   for (int c = 0; c < 2; c++) {
     o[c].coarse_dofs = 100;
     o[c].cycle_index = c + 1;
+    o[c].block_fraction = c ? 0.5 : 1.0; /* the blocks of the cells with a small piece */
     snprintf(what, sizeof what, "%s, cycle %d, before the cuts", name, c + 1);
     mg[c] = carry_and_compare(ctx, NULL, NULL, &base, &o[c], what, &pattern[c]);
   }

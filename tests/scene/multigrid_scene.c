@@ -425,6 +425,10 @@ static void mode_errors(fcm_ctx *ctx)
       "solver.multigrid.point_sweep", "\"sgs\"");
   bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"coarse_interval\": 0}}",
       "solver.multigrid.coarse_interval", "1");
+  bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"block_fraction\": 0}}",
+      "solver.multigrid.block_fraction", "(0, 1]");
+  bad(ctx, "hex8", "{\"method\": \"multigrid\", \"multigrid\": {\"block_fraction\": 1.5}}",
+      "solver.multigrid.block_fraction", "(0, 1]");
   bad(ctx, "tet4", "{\"method\": \"minres\", \"preconditioner\": \"multigrid\"}",
       "solver.preconditioner", "\"tet4\"");
   bad(ctx, "hex8", "{\"method\": \"mg\"}", "solver.method", "\"multigrid\"");
@@ -451,15 +455,16 @@ static void mode_errors(fcm_ctx *ctx)
                     " \"material\": {\"model\": \"linear\", \"young\": 1e6, \"poisson\": 0.3},"
                     " \"solver\": {\"method\": \"multigrid\", \"multigrid\": {\"block_smoothing\":"
                     " false, \"cycle\": \"w\", \"coarse_dofs\": 77, \"pre_smooth\": 3,"
-                    " \"blocks\": \"element\", \"block_sweep\": \"one_way\","
-                    " \"point_sweep\": \"one_way\", \"coarse_interval\": 4}},"
+                    " \"blocks\": \"element\", \"block_fraction\": 0.25, \"block_sweep\":"
+                    " \"one_way\", \"point_sweep\": \"one_way\", \"coarse_interval\": 4}},"
                     " \"time\": {\"static\": true}, \"effects\": []}";
     TEST_OK(ctx, fcm_scene_create_from_string(ctx, j, "hex20.json", &sc));
     if (sc) {
       const fcm_mg_options *m = &fcm_scene_get_solver(sc)->integrator.multigrid;
       TEST_TRUE(m->block_smoothing == 0 && m->cycle_index == 2 && m->coarse_dofs == 77 &&
                 m->pre_smooth == 3 && m->post_smooth == 1 && m->blocks == FCM_MG_BLOCKS_ELEMENT &&
-                m->block_sweep == 1 && m->point_sweep == 1 && m->coarse_interval == 4);
+                m->block_fraction == 0.25 && m->block_sweep == 1 && m->point_sweep == 1 &&
+                m->coarse_interval == 4);
     }
     fcm_scene_destroy(&sc);
   }
