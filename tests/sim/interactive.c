@@ -212,6 +212,16 @@ static void refused(fcm_ctx *ctx, const fcm_space *space, fcm_index nfix, const 
   if (integ)
     TEST_ERR(ctx, fcm_integrator_setup(integ), FCM_ERR_ARG, "multigrid_fixed_cycles = 1001");
   fcm_integrator_destroy(&integ);
+  /* the finest level's block fraction outside (0, 1]: refused, naming it */
+  static const double bad_fraction[] = {0.0, 1.5, NAN};
+  for (int k = 0; k < 3; k++) {
+    o = fcm_integrator_options_default();
+    o.linear_solver = FCM_LINEAR_MULTIGRID;
+    o.multigrid.block_fraction = bad_fraction[k];
+    TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, &o, &integ));
+    if (integ) TEST_ERR(ctx, fcm_integrator_setup(integ), FCM_ERR_ARG, "multigrid.block_fraction");
+    fcm_integrator_destroy(&integ);
+  }
   (void)nfix;
   (void)fix;
 }

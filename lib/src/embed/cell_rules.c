@@ -80,7 +80,9 @@ static fcm_status build_rules_x(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_ge
   if (B.cut_tree) FCM_TRY(ctx, fcm__embed_gather_links(&B, R, out));
   {
     /* the kept face polygons (which move out of the cells' outputs) and the statistics (which
-     * read the outputs' other fields and allocate nothing) side by side */
+     * read the outputs' other fields and allocate nothing) side by side; the polygons' error,
+     * on whichever thread, goes to the context (no caller builds rules inside an fcm__loop
+     * iteration, whose record would want it) */
     fcm_status kept = FCM_OK;
 #pragma omp parallel sections num_threads(2) if (B.cut_tree && nthreads > 1)
     {

@@ -482,9 +482,10 @@ cleanup:
 }
 
 /* Block smoothers (block_smoothing). Level 0: one block per grid vertex of the cut cells
- * (de Prenter et al. 2020): the DOFs of the copies whose support lies in the vertex's patch
- * of 8 cells, the vertex's own and (Hex20) those of the mid-edge nodes of the edges at the
- * vertex, all copies together; then one block per element of a cut cell (all its DOFs).
+ * block_cells() selects (de Prenter et al. 2020): the DOFs of the copies whose support lies
+ * in the vertex's patch of 8 cells, the vertex's own and (Hex20) those of the mid-edge nodes
+ * of the edges at the vertex, all copies together; then one block per element of such a cell
+ * (all its DOFs).
  * Coarser levels: one block per coarse cell that is not all material (its 8 corner copies).
  * Each block is inverted by the clamped eigen-inverse of fcm_schwarz (Longva et al. 2020,
  * §5.2). Vertex blocks resolve the nearly dependent functions of one vertex's patch (Hex20:
@@ -493,7 +494,6 @@ cleanup:
  * cells with little material (the hollow ball's V-cycle grew with n without them). On octree
  * spaces level 0's blocks take the masters of their hanging DOFs (blocks_masters()), and the
  * octree levels of a cut space the images of the finer blocks (blocks_image()). */
-/* Level 0: the vertex blocks, then the element blocks of the cut cells. */
 /* The cut cells that get the finest level's blocks (m->opts.block_fraction): those one of whose
  * pieces holds less than that fraction of the cell (its pieces' volumes against the cell's,
  * the material's volume over its fraction); every cut cell at 1, or without the rules. *out:
@@ -526,6 +526,7 @@ cleanup:
   return st;
 }
 
+/* Level 0: the vertex blocks, then the element blocks of the cut cells block_cells() selects. */
 static fcm_status blocks_level0(fcm_mg *m, fcm_index *nb_out, fcm_index **ptr_out,
                                 fcm_index **dofs_out)
 {

@@ -5,18 +5,31 @@
 /* ---------------------------------------------------------------- view */
 
 /* " (sgs omega auto (1), 1+1 steps, V-cycle, coarse 2000 DOFs)": omega 0 is the smoother's
- * own (fcm_mg_smoother_omega()), shown with its value; a given omega as it is */
+ * own (fcm_mg_smoother_omega()), shown with its value; a given omega as it is; then the block
+ * and sweep options where they differ from the defaults (so that a checkpoint's fingerprint,
+ * which hashes this view, tells runs of different cycles apart, and a scene without them keeps
+ * its view) */
 static void view_multigrid(FILE *f, const fcm_mg_options *m)
 {
+  static const char *const blocks[FCM_MG_BLOCKS_COUNT] = {"all", "vertex", "element"};
   fprintf(f, " (%s omega ",
           SCENE_CHOICE_NAME(fcm__scene_smoother_names, fcm__scene_smoother_values, m->smoother));
   if (m->omega == 0.0)
     fprintf(f, "auto (%g)", fcm_mg_smoother_omega(m->smoother));
   else
     fprintf(f, "%g", m->omega);
-  fprintf(f, ", %d+%d steps%s, %s-cycle, coarse %lld DOFs)", m->pre_smooth, m->post_smooth,
+  fprintf(f, ", %d+%d steps%s, %s-cycle, coarse %lld DOFs", m->pre_smooth, m->post_smooth,
           m->block_smoothing ? " with vertex blocks" : "", m->cycle_index == 2 ? "W" : "V",
           (long long)m->coarse_dofs);
+  if (m->block_smoothing && m->blocks != FCM_MG_BLOCKS_ALL && m->blocks >= 0 &&
+      m->blocks < FCM_MG_BLOCKS_COUNT)
+    fprintf(f, ", %s blocks", blocks[m->blocks]);
+  if (m->block_smoothing && m->block_fraction < 1.0)
+    fprintf(f, ", blocks at cells with a piece under %g", m->block_fraction);
+  if (m->block_smoothing && m->block_sweep) fprintf(f, ", blocks one way");
+  if (m->point_sweep) fprintf(f, ", points one way");
+  if (m->coarse_interval > 1) fprintf(f, ", coarse values every %d set-ups", m->coarse_interval);
+  fprintf(f, ")");
 }
 
 static void view_strength(FILE *f, const char *what, int m)
