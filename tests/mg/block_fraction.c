@@ -1,9 +1,10 @@
 /* fcm_mg_options.block_fraction on the hemisphere with the XFEM plane cut (Hex8): the finest
  * level's element blocks are those of the elements of the cut cells one of whose pieces holds
  * less than the fraction of its cell, counted here from the pieces' volumes and the cell's box
- * (1, the default: every cut cell); a smaller fraction gives fewer blocks; CG with one V-cycle of the smaller block set still converges to
- * CHOLMOD's solution, in at most 1.5 times the iterations of the full set plus 2; the vertex
- * blocks follow the same cells; a fraction outside (0, 1] is refused. */
+ * (1, the default: every cut cell); a smaller fraction gives fewer blocks; CG with one
+ * V-cycle of the smaller block set still converges to CHOLMOD's solution, in at most 1.5 times
+ * the iterations of the full set plus 2; the vertex blocks follow the same cells; a fraction
+ * outside (0, 1] is refused. */
 #include "mg/levels_impl.h"
 #include "mg_util.h"
 #include "solve/solve_impl.h"
