@@ -152,6 +152,49 @@ static void *poisoned_alloc(void *user, size_t size)
   return p;
 }
 
+/* The cut of the allocation-failure tests: a surface ball (no volume mesh) on a 4 x 4 x 3 Hex8
+ * grid with its rules (surface moments, the stiffness on the mass space), and a slanted blade. */
+typedef struct cut_case {
+  fcm_mesh *mesh;
+  fcm_geometry *tets, *g;
+  fcm_surface *s, *blade;
+  fcm_cell_rules *r0;
+} cut_case;
+
+static void cut_case_make(fcm_ctx *ctx, cut_case *c)
+{
+  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c0[3] = {0.07, -0.03, 0.02};
+  const fcm_index n[3] = {4, 4, 3};
+  const double p[3] = {0.11, 0.0, 0.0}, nrm[3] = {1.0, 0.2, 0.1}, plo[3] = {-2, -2, -2},
+               phi[3] = {2, 2, 2};
+  memset(c, 0, sizeof *c);
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &c->mesh));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.8, 1, &c->tets));
+  if (c->tets)
+    TEST_OK(ctx,
+            fcm_surface_create(ctx, fcm_geometry_num_nodes(c->tets), fcm_geometry_coords(c->tets),
+                               fcm_geometry_num_boundary_triangles(c->tets),
+                               fcm_geometry_boundary_triangles(c->tets), &c->s));
+  fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
+  mo.volume_mesh = 0;
+  if (c->s) TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, c->s, &mo, &c->g));
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p, nrm, plo, phi, &c->blade));
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.moments = FCM_CELL_MOMENTS_SURFACE;
+  o.stiffness_on_mass_space = 1;
+  if (c->mesh && c->g) TEST_OK(ctx, fcm_cell_rules_create(ctx, c->mesh, c->g, &o, &c->r0));
+}
+
+static void cut_case_free(cut_case *c)
+{
+  fcm_cell_rules_destroy(&c->r0);
+  fcm_surface_destroy(&c->blade);
+  fcm_surface_destroy(&c->s);
+  fcm_geometry_destroy(&c->g);
+  fcm_geometry_destroy(&c->tets);
+  fcm_mesh_destroy(&c->mesh);
+}
+
 static void cut_allocation_failures(void)
 {
   failing f;
@@ -160,28 +203,12 @@ static void cut_allocation_failures(void)
   TEST_TRUE(ctx != NULL);
   if (!ctx) return;
   TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1)); /* the failing allocator's counter is not atomic */
-  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c0[3] = {0.07, -0.03, 0.02};
-  const fcm_index n[3] = {4, 4, 3};
-  const double p[3] = {0.11, 0.0, 0.0}, nrm[3] = {1.0, 0.2, 0.1}, plo[3] = {-2, -2, -2},
-               phi[3] = {2, 2, 2};
-  fcm_mesh *mesh = NULL;
-  fcm_geometry *tets = NULL, *g = NULL;
-  fcm_surface *s = NULL, *blade = NULL;
-  fcm_cell_rules *r0 = NULL, *ref = NULL;
-  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
-  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.8, 1, &tets));
-  if (tets)
-    TEST_OK(ctx, fcm_surface_create(ctx, fcm_geometry_num_nodes(tets), fcm_geometry_coords(tets),
-                                    fcm_geometry_num_boundary_triangles(tets),
-                                    fcm_geometry_boundary_triangles(tets), &s));
-  fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
-  mo.volume_mesh = 0;
-  if (s) TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, s, &mo, &g));
-  TEST_OK(ctx, fcm_surface_create_plane(ctx, p, nrm, plo, phi, &blade));
-  fcm_cell_rules_options o = fcm_cell_rules_options_default();
-  o.moments = FCM_CELL_MOMENTS_SURFACE;
-  o.stiffness_on_mass_space = 1;
-  if (mesh && g) TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r0));
+  cut_case cc;
+  cut_case_make(ctx, &cc);
+  fcm_mesh *mesh = cc.mesh;
+  fcm_geometry *g = cc.g;
+  fcm_surface *blade = cc.blade;
+  fcm_cell_rules *r0 = cc.r0, *ref = NULL;
   if (r0 && blade) TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &ref));
   const long long live = fcm_ctx_live_allocations(ctx);
   int ok = 0, fails = 0;
@@ -217,12 +244,7 @@ static void cut_allocation_failures(void)
   }
   TEST_TRUE(ok && fails > 100);
   fcm_cell_rules_destroy(&ref);
-  fcm_cell_rules_destroy(&r0);
-  fcm_surface_destroy(&blade);
-  fcm_surface_destroy(&s);
-  fcm_geometry_destroy(&g);
-  fcm_geometry_destroy(&tets);
-  fcm_mesh_destroy(&mesh);
+  cut_case_free(&cc);
   fcm_ctx_destroy(&ctx);
 }
 
@@ -237,28 +259,12 @@ static void cut_allocation_failures_two_threads(void)
   TEST_TRUE(ctx != NULL);
   if (!ctx) return;
   TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 2));
-  const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c0[3] = {0.07, -0.03, 0.02};
-  const fcm_index n[3] = {4, 4, 3};
-  const double p[3] = {0.11, 0.0, 0.0}, nrm[3] = {1.0, 0.2, 0.1}, plo[3] = {-2, -2, -2},
-               phi[3] = {2, 2, 2};
-  fcm_mesh *mesh = NULL;
-  fcm_geometry *tets = NULL, *g = NULL;
-  fcm_surface *s = NULL, *blade = NULL;
-  fcm_cell_rules *r0 = NULL, *ref = NULL;
-  TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
-  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 0.8, 1, &tets));
-  if (tets)
-    TEST_OK(ctx, fcm_surface_create(ctx, fcm_geometry_num_nodes(tets), fcm_geometry_coords(tets),
-                                    fcm_geometry_num_boundary_triangles(tets),
-                                    fcm_geometry_boundary_triangles(tets), &s));
-  fcm_surface_mesh_options mo = fcm_surface_mesh_options_default();
-  mo.volume_mesh = 0;
-  if (s) TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, s, &mo, &g));
-  TEST_OK(ctx, fcm_surface_create_plane(ctx, p, nrm, plo, phi, &blade));
-  fcm_cell_rules_options o = fcm_cell_rules_options_default();
-  o.moments = FCM_CELL_MOMENTS_SURFACE;
-  o.stiffness_on_mass_space = 1;
-  if (mesh && g) TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, g, &o, &r0));
+  cut_case cc;
+  cut_case_make(ctx, &cc);
+  fcm_mesh *mesh = cc.mesh;
+  fcm_geometry *g = cc.g;
+  fcm_surface *blade = cc.blade;
+  fcm_cell_rules *r0 = cc.r0, *ref = NULL;
   long long total = 0;
   if (r0 && blade) {
     f.count = 0;
@@ -290,12 +296,7 @@ static void cut_allocation_failures_two_threads(void)
   }
   TEST_TRUE(total > 0 && fails > 100);
   fcm_cell_rules_destroy(&ref);
-  fcm_cell_rules_destroy(&r0);
-  fcm_surface_destroy(&blade);
-  fcm_surface_destroy(&s);
-  fcm_geometry_destroy(&g);
-  fcm_geometry_destroy(&tets);
-  fcm_mesh_destroy(&mesh);
+  cut_case_free(&cc);
   fcm_ctx_destroy(&ctx);
 }
 
