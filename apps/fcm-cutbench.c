@@ -20,19 +20,22 @@
 /* The option set each row runs beside the defaults when --interactive does not give one ("":
  * none). */
 static const char *const row_interactive[ROW_COUNT] = {
-    /* Dick: one Newton iteration of three multigrid V-cycles a step (his 3 V-cycles), the
-     * blocks of the cut cells with a piece under half the cell and the pointwise smoothing one
-     * way, the coarse levels' values every fourth step (lib/docs/cutting.md, "The interactive
-     * step") */
+    /* Dick: one Newton iteration of three multigrid V-cycles a step (his 3 V-cycles) on his
+     * warped tangent R K R^T (the corotated model's PSD tangent), the blocks of the cut cells
+     * with a piece under half the cell and the pointwise smoothing one way, the coarse levels'
+     * values every fourth step (lib/docs/cutting.md, "The interactive step") */
     "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"multigrid\": {\"cycle\": \"v\", "
     "\"blocks\": \"element\", \"block_fraction\": 0.5, \"block_sweep\": \"one_way\", "
-    "\"point_sweep\": \"one_way\", \"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1}",
+    "\"point_sweep\": \"one_way\", \"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1, "
+    "\"project_psd\": true}",
     "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"multigrid\": {\"cycle\": \"v\", "
     "\"blocks\": \"element\", \"block_fraction\": 0.5, \"block_sweep\": \"one_way\", "
-    "\"point_sweep\": \"one_way\", \"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1}",
+    "\"point_sweep\": \"one_way\", \"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1, "
+    "\"project_psd\": true}",
     "\"method\": \"multigrid\", \"fixed_cycles\": 3, \"multigrid\": {\"cycle\": \"v\", "
     "\"blocks\": \"element\", \"block_fraction\": 0.5, \"block_sweep\": \"one_way\", "
-    "\"point_sweep\": \"one_way\", \"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1}",
+    "\"point_sweep\": \"one_way\", \"coarse_interval\": 4}, \"newton\": {\"fixed_iterations\": 1, "
+    "\"project_psd\": true}",
     /* Koschier: one Newton iteration a step, direct solves */
     "\"newton\": {\"fixed_iterations\": 1}", "\"newton\": {\"fixed_iterations\": 1}",
     /* Ton-That: one Newton iteration a step on the PSD-projected tangent (Ton-That's

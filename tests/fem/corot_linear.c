@@ -6,8 +6,10 @@
  *  - a rigid motion (rotation by 1.2 rad and a translation) has zero energy and force (to 1e-12
  *    of the force scale |K| L), and rotating a deformed body rotates its force and keeps its
  *    energy;
- *  - the force is the energy's gradient (central differences at a deformed state) and, at a
- *    rigidly rotated state, the tangent is the force's derivative;
+ *  - the force is the energy's gradient (central differences at a deformed state) and the
+ *    tangent is the force's derivative, at a rigidly rotated state and at a deformed and
+ *    rotated one (the exact Hessian, symmetric); there the PSD tangent (project_psd, the
+ *    warped R K R^T) is positive semi-definite and misses the rotation terms;
  *  - the element matrices are kept: later assemblies build none, until the Lame parameters
  *    change.
  * Usage: fem_corot_linear <element> */
@@ -172,6 +174,51 @@ static void check_space(fcm_space *space, const fcm_mesh *mesh)
       diff = fmax(diff, fabs((fp[i] - fm[i]) / (2 * h) - Ku[i]));
     printf("tangent at a rotation: |T du - FD| / |T du| = %.3g\n", diff / max_abs(n, Ku));
     TEST_TRUE(diff <= 1e-6 * max_abs(n, Ku));
+  }
+  /* at a deformed and rotated state: the exact Hessian; the PSD tangent misses its rotation
+   * terms there, of the order of the strains (w is about 5 %) */
+  {
+    const double h = 1e-6;
+    double *x = calloc((size_t)n, sizeof *x), *dv = calloc((size_t)n, sizeof *dv);
+    double *Tv = calloc((size_t)n, sizeof *Tv);
+    for (fcm_index i = 0; i < n; i++)
+      dv[i] = 0.05 * urand(&seed); /* w is a rigid rotation by now */
+    rotate(space, mesh, Q, tr, dv, x);
+    for (fcm_index i = 0; i < n; i++)
+      u[i] = x[i] + h * du[i];
+    eval(ws, &p, u, fp, NULL, n);
+    for (fcm_index i = 0; i < n; i++)
+      u[i] = x[i] - h * du[i];
+    eval(ws, &p, u, fm, NULL, n);
+    for (fcm_index i = 0; i < n; i++)
+      fp[i] = (fp[i] - fm[i]) / (2 * h); /* the force's derivative along du */
+    eval(ws, &p, x, f, T, n);
+    TEST_OK(ctx, fcm_csr_apply(T, 1.0, du, 0.0, Ku));
+    TEST_OK(ctx, fcm_csr_apply(T, 1.0, dv, 0.0, Tv));
+    double diff = 0.0;
+    for (fcm_index i = 0; i < n; i++)
+      diff = fmax(diff, fabs(fp[i] - Ku[i]));
+    const double scale = max_abs(n, Ku), asym = fabs(dot(n, dv, Ku) - dot(n, du, Tv));
+    printf("exact tangent, deformed: |T du - FD| / |T du| = %.3g, asymmetry %.3g\n", diff / scale,
+           asym / fabs(dot(n, dv, Ku)));
+    TEST_TRUE(diff <= 1e-6 * scale);
+    TEST_TRUE(asym <= 1e-12 * fabs(dot(n, dv, Ku)) + 1e-14 * kmax);
+    fcm_material_params pp = p;
+    pp.project_psd = 1;
+    eval(ws, &pp, x, f, T, n);
+    TEST_OK(ctx, fcm_csr_apply(T, 1.0, du, 0.0, Ku));
+    double miss = 0.0;
+    for (fcm_index i = 0; i < n; i++)
+      miss = fmax(miss, fabs(fp[i] - Ku[i]));
+    printf("PSD tangent, deformed: |T du - FD| / |T du| = %.3g\n", miss / max_abs(n, Ku));
+    TEST_TRUE(miss >= 1e-3 * max_abs(n, Ku));
+    for (int k = 0; k < 5; k++) {
+      for (fcm_index i = 0; i < n; i++)
+        dv[i] = urand(&seed) - 0.5;
+      TEST_OK(ctx, fcm_csr_apply(T, 1.0, dv, 0.0, Tv));
+      TEST_TRUE(dot(n, dv, Tv) >= -1e-12 * kmax * dot(n, dv, dv));
+    }
+    free(x), free(dv), free(Tv);
   }
   TEST_TRUE(fcm__assembly_corot_built(ws) == ne);
   /* other Lame parameters: every element built again */

@@ -3,7 +3,10 @@
  * integrator (FCM_CUT_REUSE_BLOCKS) keeps the element stiffness matrices of the elements the
  * cut leaves and integrates only the others again; three steps after the cut give the same
  * displacement bits as an integrator built from scratch on the cut space. The interactive
- * option (one Newton iteration) runs the model too. Usage: sim_corot_linear <element> */
+ * option (one Newton iteration) runs the model too. A static step that shears the box by
+ * about a fifth: Newton on the exact tangent ends quadratically (its last residual below
+ * the square of the one before, relative to the first), on the PSD tangent (project_psd,
+ * the warped R K R^T) linearly and in more iterations. Usage: sim_corot_linear <element> */
 #include "fem/fem_impl.h"
 #include "sim/sim_impl.h"
 #include "sim_util.h"
@@ -18,6 +21,60 @@ static fcm_status hold_base(fcm_integrator *I, const fcm_mesh *mesh)
 {
   const double lo[3] = {-10, -10, -10}, hi[3] = {10, 0.05, 10};
   return hold_box(ctx, I, mesh, lo, hi);
+}
+
+/* The residuals a monitor saw, relative to the first. */
+typedef struct trace {
+  int n;
+  double r[64];
+} trace;
+
+static void record(void *user, const fcm_newton_event *ev)
+{
+  trace *t = user;
+  if (t->n < 64) t->r[t->n++] = ev->residual;
+}
+
+/* Whether the residuals end quadratically: after the first one below 1e-4 of the first, the
+ * next is below 10 times its square (or at rounding, 1e-12). */
+static int quadratic_end(const trace *t)
+{
+  for (int k = 1; k + 1 < t->n; k++) {
+    const double a = t->r[k] / t->r[0], b = t->r[k + 1] / t->r[0];
+    if (a < 1e-4) return b <= 10.0 * a * a || b <= 1e-12;
+  }
+  return 0;
+}
+
+/* One static step of the box sheared sideways by its weight; the Newton residuals into t. */
+static void shear_step(const fcm_space *space, const fcm_mesh *mesh, int project, trace *t)
+{
+  fcm_integrator_options o = fcm_integrator_options_default();
+  o.kind = FCM_INTEGRATOR_STATIC;
+  o.newton_tolerance = 1e-11;
+  o.project_psd = project;
+  o.monitor = record;
+  o.monitor_user = t;
+  t->n = 0;
+  fcm_integrator *I = NULL;
+  const double side[3] = {-3.0, 0.0, 0.0}; /* rho g H / G about 0.23: a large shear */
+  TEST_OK(ctx, fcm_integrator_create(ctx, space, &mat, &o, &I));
+  TEST_OK(ctx, fcm_integrator_add_gravity(I, side, NULL, NULL));
+  TEST_OK(ctx, hold_base(I, mesh));
+  TEST_OK(ctx, fcm_integrator_setup(I));
+  fcm_step_info info;
+  TEST_OK(ctx, fcm_integrator_step(I, &info));
+  TEST_TRUE(info.reason == FCM_STEP_CONVERGED);
+  const double *u = fcm_integrator_displacement(I);
+  double ux = 0.0;
+  for (fcm_index d = 0; d < fcm_integrator_num_dofs(I); d += 3)
+    ux = fmin(ux, u[d]);
+  printf("shear, %s tangent: %d Newton iterations, min u_x = %.4g, residuals",
+         project ? "PSD" : "exact", t->n - 1, ux);
+  for (int k = 0; k < t->n; k++)
+    printf(" %.2e", t->r[k] / t->r[0]);
+  printf("\n");
+  fcm_integrator_destroy(&I);
 }
 
 static fcm_integrator *make(const fcm_space *space, const fcm_mesh *mesh,
@@ -113,6 +170,16 @@ int main(int argc, char **argv)
   TEST_OK(ctx, fcm_integrator_setup(F));
   steps(F, 3, 0);
   TEST_TRUE(min_uy(F) < -1e-5 && isfinite(min_uy(F)));
+
+  /* a large static shear: the exact tangent's Newton ends quadratically, the PSD one's not */
+  trace te, tp;
+  shear_step(space, mesh, 0, &te);
+  shear_step(space, mesh, 1, &tp);
+  TEST_TRUE(te.n >= 3 && tp.n >= 3);
+  if (te.n >= 3 && tp.n >= 3) {
+    TEST_TRUE(quadratic_end(&te) && !quadratic_end(&tp));
+    TEST_TRUE(tp.n >= te.n + 3);
+  }
 
   fcm_integrator_destroy(&I);
   fcm_integrator_destroy(&C);

@@ -16,11 +16,26 @@
  * g_b the mean physical gradient of node b's shape function (F = sum_a x_a g_a^T). m is the
  * moment of the element's elastic forces in its rotated frame, of second order in d (K's rigid
  * rotations carry no force): the z term is the small correction that makes the force a
- * gradient (Dick's warped force R K d drops it). The tangent is the warped [R] K [R]^T (the
- * terms of dR/dx, of the order of the element's stress, dropped as Dick does): symmetric
- * positive semi-definite, so Newton's direction is a descent direction of E and its line
- * search applies unchanged; Newton converges linearly then, at a rate of the order of the
- * strains. */
+ * gradient (Dick's warped force R K d drops it).
+ *
+ * The tangent is E's exact Hessian, unless the material asks for a positive semi-definite one
+ * (project_psd: the Newton loop's projection fallback, the multigrid solver's SPD matrices,
+ * Dick's interactive steps), which is the warped [R] K [R]^T: it drops the terms of dR/dx, of
+ * the order of the element's stress, so that Newton converges only linearly on it, at a rate
+ * of the order of the strains, and slowly where a thin part carries a heavy one through a
+ * large rotation. The exact Hessian, with u_b = R^T dx_b the nodal variation in the rotated
+ * frame (translations drop out: K ignores them and the g_b sum to zero) and q_b = (K d)_b -
+ * z x g_b the rotated force, is [R] (K + D) [R]^T with
+ *   dd_a = u_a + [y_a]x w,      w = A^{-1} sum_b [g_b]x u_b   (A = tr S I - S),
+ *   dm = -h(Kd) u - C w + h(y) K dd,   C = sum_a [(Kd)_a]x [y_a]x,
+ *   dA z = (sum_b g_b . u_b) z - sum_b (g_b . z) u_b - [S z]x w,
+ *   dz = A^{-1} (dm - dA z),
+ *   D u = K s(y) w - s(q) w + s(g) dz,
+ * where s(v) stacks the nodes' [v_a]x in a column (3 nn x 3) and h(v) = -s(v)^T in a row: a
+ * rank-6 correction U V^T of K (U = [K s(y) - s(q), s(g)], V^T = [dw/du; dz/du]), symmetric
+ * as a Hessian is (symmetrized to rounding here). It may be indefinite (compression, or a
+ * nearly degenerate element): the direct solver's Cholesky factorization then fails and the
+ * Newton loop takes the warped tangent for the rest of the step. */
 #include "fem/kernels_impl.h"
 #include "la/mat3.h"
 
@@ -107,6 +122,114 @@ static void warp_blocks(int nn, const double *Kp, const double R[9], double *Kt)
   }
 }
 
+/* c = a x e_j (the column j of [a]x). */
+static void cross_unit(const double a[3], int j, double c[3])
+{
+  const double e[3] = {j == 0, j == 1, j == 2};
+  cross(a, e, c);
+}
+
+/* The exact Hessian's rotation terms (the header's D, in the rotated frame), rotated by R and
+ * added to the element's upper node blocks Kt: Kt_ab += R sym(U V^T)_ab R^T. y: the nodes in
+ * the rotated frame, Kd: K d, z: the force's spin term. */
+static void add_rotation_terms(int nn, const double *Kp, const double *g, const polar *p,
+                               const double *y, const double *Kd, const double z[3], double *Kt)
+{
+  enum { NMAX = 3 * FCM_ELEMENT_MAX_NODES };
+  const int N = 3 * nn;
+  double U[NMAX * 6], V[NMAX * 6], KY[NMAX * 3], col[NMAX], t[NMAX];
+  for (int j = 0; j < 3; j++) { /* K s(y), a column at a time */
+    for (int a = 0; a < nn; a++)
+      cross_unit(y + 3 * a, j, col + 3 * a);
+    packed_matvec(nn, Kp, col, t);
+    for (int r = 0; r < N; r++)
+      KY[3 * r + j] = t[r];
+  }
+  /* U = [K s(y) - s(q), s(g)]; C = sum_a [(Kd)_a]x [y_a]x; s(y)^T K s(y) */
+  double C[9] = {0}, YKY[9] = {0};
+  for (int a = 0; a < nn; a++) {
+    double zg[3], q[3], P[9], Y[9];
+    cross(z, g + 3 * a, zg);
+    for (int i = 0; i < 3; i++)
+      q[i] = Kd[3 * a + i] - zg[i];
+    for (int j = 0; j < 3; j++) {
+      double sq[3], sg[3], sp[3], sy[3];
+      cross_unit(q, j, sq);
+      cross_unit(g + 3 * a, j, sg);
+      cross_unit(Kd + 3 * a, j, sp);
+      cross_unit(y + 3 * a, j, sy);
+      for (int i = 0; i < 3; i++) {
+        const int r = 3 * a + i;
+        U[6 * r + j] = KY[3 * r + j] - sq[i];
+        U[6 * r + 3 + j] = sg[i];
+        P[3 * i + j] = sp[i];
+        Y[3 * i + j] = sy[i];
+      }
+    }
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        C[3 * i + j] += P[3 * i] * Y[j] + P[3 * i + 1] * Y[3 + j] + P[3 * i + 2] * Y[6 + j];
+        YKY[3 * i + j] += Y[i] * KY[3 * (3 * a) + j] + Y[3 + i] * KY[3 * (3 * a + 1) + j] +
+                          Y[6 + i] * KY[3 * (3 * a + 2) + j];
+      }
+  }
+  /* dm - dA z = (Mu - L) u + Mw w, Mw = -C - s(y)^T K s(y) + [S z]x */
+  double Sz[3], vz[3], Mw[9];
+  fcm__mat3_tmulv(p->V, z, vz);
+  for (int k = 0; k < 3; k++)
+    vz[k] *= p->s[k];
+  fcm__mat3_mulv(p->V, vz, Sz);
+  const double SzX[9] = {0, -Sz[2], Sz[1], Sz[2], 0, -Sz[0], -Sz[1], Sz[0], 0};
+  for (int k = 0; k < 9; k++)
+    Mw[k] = -C[k] - YKY[k] + SzX[k];
+  /* V's rows: w and dz for the unit variation of DOF r = (b, i) */
+  for (int b = 0; b < nn; b++) {
+    const double *gb = g + 3 * b;
+    const double gz = gb[0] * z[0] + gb[1] * z[1] + gb[2] * z[2];
+    for (int i = 0; i < 3; i++) {
+      const int r = 3 * b + i;
+      double hg[3], w[3], hp[3], v[3], dz[3];
+      cross_unit(gb, i, hg);
+      solve_spin(p, hg, w);
+      cross_unit(Kd + 3 * b, i, hp);
+      for (int k = 0; k < 3; k++) /* Mu = -h(Kd) - (K s(y))^T, L = z g^T - (g.z) I */
+        v[k] = -hp[k] - KY[3 * r + k] - (z[k] * gb[i] - (k == i ? gz : 0.0)) + Mw[3 * k] * w[0] +
+               Mw[3 * k + 1] * w[1] + Mw[3 * k + 2] * w[2];
+      solve_spin(p, v, dz);
+      for (int k = 0; k < 3; k++) {
+        V[6 * r + k] = w[k];
+        V[6 * r + 3 + k] = dz[k];
+      }
+    }
+  }
+  /* into the global frame: each node's three rows of U and V turned by R */
+  const double *R = p->R;
+  for (int a = 0; a < nn; a++)
+    for (int k = 0; k < 6; k++) {
+      double *Ua = U + 6 * 3 * a + k, *Va = V + 6 * 3 * a + k;
+      const double u0[3] = {Ua[0], Ua[6], Ua[12]}, v0[3] = {Va[0], Va[6], Va[12]};
+      double ru[3], rv[3];
+      fcm__mat3_mulv(R, u0, ru);
+      fcm__mat3_mulv(R, v0, rv);
+      for (int i = 0; i < 3; i++) {
+        Ua[6 * i] = ru[i];
+        Va[6 * i] = rv[i];
+      }
+    }
+  for (int a = 0; a < nn; a++)
+    for (int b = a; b < nn; b++, Kt += 9)
+      for (int i = 0; i < 3; i++) {
+        const double *ur = U + 6 * (3 * a + i), *vr = V + 6 * (3 * a + i);
+        for (int j = 0; j < 3; j++) {
+          const double *uc = U + 6 * (3 * b + j), *vc = V + 6 * (3 * b + j);
+          double sum = 0.0;
+          for (int k = 0; k < 6; k++)
+            sum += ur[k] * vc[k] + uc[k] * vr[k];
+          Kt[3 * i + j] += 0.5 * sum;
+        }
+      }
+}
+
 cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const double *gbar, int nn,
                               scratch *w)
 {
@@ -147,9 +270,14 @@ cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const dou
   }
   res.energy = 0.5 * E;
   if (!isfinite(res.energy)) res.nonfinite = 1;
+  double z[3];
+  solve_spin(&pr, m, z);
+  /* the tangent first: the force is written over Kd (w->fe) */
+  if (kd->want_tangent) {
+    warp_blocks(nn, Kp, R, w->Ke);
+    if (!kd->mat->project_psd) add_rotation_terms(nn, Kp, gbar, &pr, y, Kd, z, w->Ke);
+  }
   if (kd->want_force) {
-    double z[3];
-    solve_spin(&pr, m, z);
     for (int a = 0; a < nn; a++) {
       double t[3], v[3];
       cross(z, gbar + 3 * a, t);
@@ -158,6 +286,5 @@ cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const dou
       fcm__mat3_mulv(R, v, w->fe + 3 * a);
     }
   }
-  if (kd->want_tangent) warp_blocks(nn, Kp, R, w->Ke);
   return res;
 }
