@@ -751,6 +751,7 @@ fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *ws,
   kd.mat_psd.project_psd = 1;
   if (mat->model == FCM_MATERIAL_COROTATED_LINEAR) {
     kd.kind = KERNEL_COROT_LINEAR;
+    kd.corot_exact = !mat->project_psd && !ws->corot_warped;
     FCM_TRY(ctx, fcm__assembly_corot_prepare(ws, mat, &kd));
   }
   FCM_TRY(ctx, run_volume_pass(ws, &kd, tangent ? fcm_csr_values(tangent) : NULL, force,

@@ -44,6 +44,7 @@ struct fcm_assembly_workspace {
   double *cell_energy; /* num_elems: energy per element of the last hyperelastic assembly */
   int *cell_inverted;  /* num_elems: its authentic points with det F <= 0 per element */
   corot_store corot;   /* the element-corotated linear model's element matrices (corot_store.c) */
+  int corot_warped; /* 1: that model's tangent is the warped one (fcm__assembly_corot_tangent()) */
 };
 
 /* The tabulated standard rule of `kind` (stiffness or mass), built on first use. */

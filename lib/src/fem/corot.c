@@ -18,14 +18,15 @@
  * rotations carry no force): the z term is the small correction that makes the force a
  * gradient (Dick's warped force R K d drops it).
  *
- * The tangent is E's exact Hessian, unless the material asks for a positive semi-definite one
- * (project_psd: the Newton loop's projection fallback, the multigrid solver's SPD matrices,
- * Dick's interactive steps), which is the warped [R] K [R]^T: it drops the terms of dR/dx, of
- * the order of the element's stress, so that Newton converges only linearly on it, at a rate
- * of the order of the strains, and slowly where a thin part carries a heavy one through a
- * large rotation. The exact Hessian, with u_b = R^T dx_b the nodal variation in the rotated
- * frame (translations drop out: K ignores them and the g_b sum to zero) and q_b = (K d)_b -
- * z x g_b the rotated force, is [R] (K + D) [R]^T with
+ * The tangent (kd->corot_exact) is E's exact Hessian, or the warped [R] K [R]^T where the
+ * material asks for a positive semi-definite one (project_psd: the Newton loop's projection
+ * fallback, the multigrid solver's SPD matrices, Dick's interactive steps) or the caller for it
+ * (fcm__assembly_corot_tangent(): the integrator starts each substep on it). The warped tangent
+ * drops the terms of dR/dx, of the order of the element's stress, so that Newton converges
+ * only linearly on it, at a rate of the order of the strains, and slowly where a thin part
+ * carries a heavy one through a large rotation. The exact Hessian, with u_b = R^T dx_b the
+ * nodal variation in the rotated frame (translations drop out: K ignores them and the g_b sum
+ * to zero) and q_b = (K d)_b - z x g_b the rotated force, is [R] (K + D) [R]^T with
  *   dd_a = u_a + [y_a]x w,      w = A^{-1} sum_b [g_b]x u_b   (A = tr S I - S),
  *   dm = -h(Kd) u - C w + h(y) K dd,   C = sum_a [(Kd)_a]x [y_a]x,
  *   dA z = (sum_b g_b . u_b) z - sum_b (g_b . z) u_b - [S z]x w,
@@ -275,7 +276,7 @@ cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const dou
   /* the tangent first: the force is written over Kd (w->fe) */
   if (kd->want_tangent) {
     warp_blocks(nn, Kp, R, w->Ke);
-    if (!kd->mat->project_psd) add_rotation_terms(nn, Kp, gbar, &pr, y, Kd, z, w->Ke);
+    if (kd->corot_exact) add_rotation_terms(nn, Kp, gbar, &pr, y, Kd, z, w->Ke);
   }
   if (kd->want_force) {
     for (int a = 0; a < nn; a++) {

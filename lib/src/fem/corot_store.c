@@ -216,3 +216,8 @@ fcm_index fcm__assembly_corot_built(const fcm_assembly_workspace *ws)
 {
   return ws->corot.built;
 }
+
+void fcm__assembly_corot_tangent(fcm_assembly_workspace *ws, int exact)
+{
+  if (ws) ws->corot_warped = !exact;
+}

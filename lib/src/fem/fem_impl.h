@@ -532,6 +532,11 @@ fcm_status fcm__assembly_corot_take(fcm_assembly_workspace *ws, fcm_assembly_wor
  * next use, the same bits. Nothing taken: nothing done. (corot_store.c) */
 void fcm__assembly_corot_give_back(fcm_assembly_workspace *ws, fcm_assembly_workspace *old);
 
+/* The tangent of the corotated linear model's later assemblies through ws: exact = 1 (the
+ * default), the energy's exact Hessian unless the material asks for a positive semi-definite
+ * one (project_psd); exact = 0, the warped R K R^T either way. (corot_store.c) */
+void fcm__assembly_corot_tangent(fcm_assembly_workspace *ws, int exact);
+
 /* The store's free slots mapped (fcm__large_map()): a later cut's new elements write them
  * without the first touch of fresh pages. For a workspace whose store a cut will take. */
 void fcm__assembly_corot_map(fcm_assembly_workspace *ws);

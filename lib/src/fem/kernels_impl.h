@@ -68,6 +68,7 @@ typedef struct kernel_data {
   size_t corot_cb;
   const double *corot_G;
   const fcm_index *corot_slot;
+  int corot_exact; /* the tangent: 1 the energy's exact Hessian, 0 the warped R K R^T */
 } kernel_data;
 
 /* Per-thread scratch of a kernel; ld = fcm__kernel_ld(nn) (the padded row length of the

@@ -45,6 +45,8 @@ static fcm_status assemble(fcm_integrator *I, const fcm_material_params *p, cons
 {
   fcm_status st = FCM_OK;
   double t0 = fcm_wtime();
+  if (I->params.model == FCM_MATERIAL_COROTATED_LINEAR)
+    fcm__assembly_corot_tangent(I->aws, I->corot_exact);
   st = fcm_assembly_workspace_hyperelastic(I->aws, p, x, psi, fint, T);
   stats->time_assembly += fcm_wtime() - t0;
   if (T) stats->tangent_assemblies++;
@@ -648,6 +650,7 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
   *reason = FCM_STEP_NONE;
   I->solve_stalled = 0;
   I->h_indefinite = 0;
+  I->corot_exact = 0;
   if (I->mg_acc) memset(I->mg_acc, 0, sizeof *I->mg_acc * (size_t)I->n);
 
   if (o->tolerance_mode == FCM_NEWTON_TOL_REPRESENTATIVE) rep_free = norm_free(I, I->Ma);
@@ -699,6 +702,17 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     /* an iteration on the kept factorization that backtracked or contracted too little:
      * the next one factors anew */
     if (used_kept && !(lr.alpha == 1.0 && lr.rt <= o->reuse_contraction * r)) I->kept_ok = 0;
+    /* the corotated linear model on the direct solver starts each substep on the warped
+     * tangent, which kept factorizations serve well while the strains are small; an iteration
+     * on a fresh factorization of it that reduced the residual by less than half (a large
+     * rotation under stress: Newton on it converges linearly and slowly there) turns the exact
+     * Hessian on for the rest of the substep, and the next iteration factors it */
+    if (I->params.model == FCM_MATERIAL_COROTATED_LINEAR && !o->project_psd && !I->corot_exact &&
+        o->linear_solver == FCM_LINEAR_DIRECT && !used_kept && !(lr.rt <= 0.5 * r)) {
+      I->corot_exact = 1;
+      I->kept = 0;
+      I->h_state = SIM_H_INVALID;
+    }
     r = lr.rt;
     met = constraints_met(I, I->u);
     tol = tolerance(I, rep_free, r_start, &ref);

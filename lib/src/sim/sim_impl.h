@@ -209,6 +209,10 @@ struct fcm_integrator {
   /* CHOLMOD found H, the exact tangent of a dynamic step, not positive definite (linsolve.c):
    * newton.c takes the PSD-projected tangent, SPD with M/h^2, instead of an LU factorization */
   int h_indefinite;
+  /* FCM_MATERIAL_COROTATED_LINEAR with the direct solver: 1 once a Newton iteration of this
+   * substep on a fresh factorization of the warped tangent reduced the residual by less than
+   * half; the tangent is the exact Hessian from then on (newton.c) */
+  int corot_exact;
   double *Ma;           /* M a_rep (n) */
   double rep_norm_full; /* ||M a_rep|| over all DOFs */
 
