@@ -8,8 +8,8 @@
  *    energy;
  *  - the force is the energy's gradient (central differences at a deformed state) and the
  *    tangent is the force's derivative, at a rigidly rotated state and at a deformed and
- *    rotated one (the exact Hessian, symmetric); there the PSD tangent (project_psd, the
- *    warped R K R^T) is positive semi-definite and misses the rotation terms;
+ *    rotated one (the exact Hessian); there the PSD tangent (project_psd, the warped
+ *    R K R^T) is positive semi-definite and misses the rotation terms;
  *  - the element matrices are kept: later assemblies build none, until the Lame parameters
  *    change.
  * Usage: fem_corot_linear <element> */
@@ -182,7 +182,7 @@ static void check_space(fcm_space *space, const fcm_mesh *mesh)
     double *x = calloc((size_t)n, sizeof *x), *dv = calloc((size_t)n, sizeof *dv);
     double *Tv = calloc((size_t)n, sizeof *Tv);
     for (fcm_index i = 0; i < n; i++)
-      dv[i] = 0.05 * urand(&seed); /* w is a rigid rotation by now */
+      dv[i] = 0.05 * urand(&seed); /* a deformation of about 5 % (w holds a rotation now) */
     rotate(space, mesh, Q, tr, dv, x);
     for (fcm_index i = 0; i < n; i++)
       u[i] = x[i] + h * du[i];
@@ -194,15 +194,12 @@ static void check_space(fcm_space *space, const fcm_mesh *mesh)
       fp[i] = (fp[i] - fm[i]) / (2 * h); /* the force's derivative along du */
     eval(ws, &p, x, f, T, n);
     TEST_OK(ctx, fcm_csr_apply(T, 1.0, du, 0.0, Ku));
-    TEST_OK(ctx, fcm_csr_apply(T, 1.0, dv, 0.0, Tv));
     double diff = 0.0;
     for (fcm_index i = 0; i < n; i++)
       diff = fmax(diff, fabs(fp[i] - Ku[i]));
-    const double scale = max_abs(n, Ku), asym = fabs(dot(n, dv, Ku) - dot(n, du, Tv));
-    printf("exact tangent, deformed: |T du - FD| / |T du| = %.3g, asymmetry %.3g\n", diff / scale,
-           asym / fabs(dot(n, dv, Ku)));
+    const double scale = max_abs(n, Ku);
+    printf("exact tangent, deformed: |T du - FD| / |T du| = %.3g\n", diff / scale);
     TEST_TRUE(diff <= 1e-6 * scale);
-    TEST_TRUE(asym <= 1e-12 * fabs(dot(n, dv, Ku)) + 1e-14 * kmax);
     fcm_material_params pp = p;
     pp.project_psd = 1;
     eval(ws, &pp, x, f, T, n);

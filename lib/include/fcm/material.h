@@ -28,8 +28,10 @@ extern "C" {
  *   2011 §5): the assembly gives each element its linear stiffness K_e (kept across steps)
  *   and one rotation R_e, the polar rotation of F averaged over the element's material (on
  *   an affine element F at the centroid): element energy
- *   1/2 d^T K_e d, d = [R_e]^T x_e - X_e, its exact gradient as the force and the warped
- *   [R_e] K_e [R_e]^T as the tangent (lib/docs/time_integration.md). At a single point
+ *   1/2 d^T K_e d, d = [R_e]^T x_e - X_e, its exact gradient as the force and its exact
+ *   Hessian as the tangent (symmetric, possibly indefinite), or with project_psd the warped
+ *   [R_e] K_e [R_e]^T, positive semi-definite (lib/docs/time_integration.md; the integrator
+ *   starts each Newton substep on the warped one). At a single point
  *   (fcm_material_eval(), stress output) it is the COROTATED model: the same energy with R
  *   taken per point. */
 typedef enum fcm_material_model {

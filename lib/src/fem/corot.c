@@ -19,14 +19,14 @@
  * gradient (Dick's warped force R K d drops it).
  *
  * The tangent (kd->corot_exact) is E's exact Hessian, or the warped [R] K [R]^T where the
- * material asks for a positive semi-definite one (project_psd: the Newton loop's projection
- * fallback, the multigrid solver's SPD matrices, Dick's interactive steps) or the caller for it
- * (fcm__assembly_corot_tangent(): the integrator starts each substep on it). The warped tangent
- * drops the terms of dR/dx, of the order of the element's stress, so that Newton converges
- * only linearly on it, at a rate of the order of the strains, and slowly where a thin part
- * carries a heavy one through a large rotation. The exact Hessian, with u_b = R^T dx_b the
- * nodal variation in the rotated frame (translations drop out: K ignores them and the g_b sum
- * to zero) and q_b = (K d)_b - z x g_b the rotated force, is [R] (K + D) [R]^T with
+ * material asks for a positive semi-definite one (project_psd, as the Newton loop's projection
+ * fallback does) or the caller for it (fcm__assembly_corot_tangent(): the integrator assembles
+ * it at the start of each substep and keeps it with solvers other than the direct one). The
+ * warped tangent drops the terms of dR/dx, of the order of the element's stress, so that
+ * Newton converges only linearly on it, at a rate of the order of the strains, and slowly where
+ * a thin part carries a heavy one through a large rotation. The exact Hessian, with u_b =
+ * R^T dx_b the nodal variation in the rotated frame (translations drop out: K ignores them and
+ * the g_b sum to zero) and q_b = (K d)_b - z x g_b the rotated force, is [R] (K + D) [R]^T with
  *   dd_a = u_a + [y_a]x w,      w = A^{-1} sum_b [g_b]x u_b   (A = tr S I - S),
  *   dm = -h(Kd) u - C w + h(y) K dd,   C = sum_a [(Kd)_a]x [y_a]x,
  *   dA z = (sum_b g_b . u_b) z - sum_b (g_b . z) u_b - [S z]x w,
@@ -35,8 +35,10 @@
  * where s(v) stacks the nodes' [v_a]x in a column (3 nn x 3) and h(v) = -s(v)^T in a row: a
  * rank-6 correction U V^T of K (U = [K s(y) - s(q), s(g)], V^T = [dw/du; dz/du]), symmetric
  * as a Hessian is (symmetrized to rounding here). It may be indefinite (compression, or a
- * nearly degenerate element): the direct solver's Cholesky factorization then fails and the
- * Newton loop takes the warped tangent for the rest of the step. */
+ * nearly degenerate element): the integrator's Cholesky factorization then fails and its
+ * Newton loop takes the warped tangent for the rest of the substep (an LU factorization, the
+ * direct_method UMFPACK or a distributed backend's, solves with it; a direction that does not
+ * descend is then computed again on the warped tangent). */
 #include "fem/kernels_impl.h"
 #include "la/mat3.h"
 

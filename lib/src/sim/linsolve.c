@@ -101,10 +101,12 @@ static fcm_status factor_direct(fcm_integrator *I, fcm_step_reason *reason, sim_
     fcm_direct_info di;
     fcm_direct_get_info(I->chol, &di);
     if (di.failed_column < 0) return singular_or_retry(I, reason); /* rank deficient */
-    if (I->key_h > 0.0 && !I->h_psd && !I->linear) {
-      /* An exact tangent of a dynamic step that is not positive definite: its Newton
-       * direction need not descend, and an LU factorization costs several Cholesky ones.
-       * The PSD-projected tangent is SPD there (M/h^2 > 0): the Newton loop takes it. */
+    if ((I->key_h > 0.0 || I->corot_exact) && !I->h_psd && !I->linear) {
+      /* An exact tangent of a dynamic step, or the corotated linear model's exact Hessian,
+       * that is not positive definite: its Newton direction need not descend, and an LU
+       * factorization costs several Cholesky ones. The PSD-projected tangent is SPD there
+       * (M/h^2 > 0; the corotated model's warped tangent is SPD on the constrained DOFs of a
+       * static step, as the linear stiffness is): the Newton loop takes it. */
       I->h_indefinite = 1;
       fcm_ctx_error_clear(ctx);
       *reason = FCM_STEP_LINEAR_SOLVER_FAILED;

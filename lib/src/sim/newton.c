@@ -702,20 +702,23 @@ fcm_status fcm__sim_newton(fcm_integrator *I, double h, double t1, fcm_step_reas
     /* an iteration on the kept factorization that backtracked or contracted too little:
      * the next one factors anew */
     if (used_kept && !(lr.alpha == 1.0 && lr.rt <= o->reuse_contraction * r)) I->kept_ok = 0;
-    /* the corotated linear model on the direct solver starts each substep on the warped
-     * tangent, which kept factorizations serve well while the strains are small; an iteration
-     * on a fresh factorization of it that reduced the residual by less than half (a large
-     * rotation under stress: Newton on it converges linearly and slowly there) turns the exact
-     * Hessian on for the rest of the substep, and the next iteration factors it */
+    const double r_prev = r;
+    r = lr.rt;
+    met = constraints_met(I, I->u);
+    tol = tolerance(I, rep_free, r_start, &ref);
+    /* the corotated linear model on the direct solver assembles the warped tangent at the
+     * start of each substep: kept factorizations serve it well while the strains are small.
+     * A corrector iteration on a fresh factorization of it that reduced the residual by less
+     * than half, with iterations to follow (a large rotation under stress, where Newton on it
+     * converges linearly and slowly), turns the exact Hessian on for the rest of the substep,
+     * and the next iteration factors it */
     if (I->params.model == FCM_MATERIAL_COROTATED_LINEAR && !o->project_psd && !I->corot_exact &&
-        o->linear_solver == FCM_LINEAR_DIRECT && !used_kept && !(lr.rt <= 0.5 * r)) {
+        o->linear_solver == FCM_LINEAR_DIRECT && !used_kept && !predictor && !last &&
+        !(lr.rt <= 0.5 * r_prev) && !(met && r <= tol)) {
       I->corot_exact = 1;
       I->kept = 0;
       I->h_state = SIM_H_INVALID;
     }
-    r = lr.rt;
-    met = constraints_met(I, I->u);
-    tol = tolerance(I, rep_free, r_start, &ref);
     monitor(I, t1, it + 1, r, tol, cur.E, lr.alpha, its, met);
   }
   /* Newton could not go on with the result of a linear solve that stagnated or broke down:
