@@ -195,6 +195,12 @@ static void cut_case_free(cut_case *c)
   fcm_mesh_destroy(&c->mesh);
 }
 
+/* c's blade applied to its rules (fcm_cell_rules_create_cut()). */
+static fcm_status cut_once(fcm_ctx *ctx, const cut_case *c, fcm_cell_rules **r)
+{
+  return fcm_cell_rules_create_cut(ctx, c->mesh, c->g, c->r0, c->blade, r);
+}
+
 static void cut_allocation_failures(void)
 {
   failing f;
@@ -205,17 +211,14 @@ static void cut_allocation_failures(void)
   TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 1)); /* the failing allocator's counter is not atomic */
   cut_case cc;
   cut_case_make(ctx, &cc);
-  fcm_mesh *mesh = cc.mesh;
-  fcm_geometry *g = cc.g;
-  fcm_surface *blade = cc.blade;
-  fcm_cell_rules *r0 = cc.r0, *ref = NULL;
-  if (r0 && blade) TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &ref));
+  fcm_cell_rules *ref = NULL;
+  if (cc.r0 && cc.blade) TEST_OK(ctx, cut_once(ctx, &cc, &ref));
   const long long live = fcm_ctx_live_allocations(ctx);
   int ok = 0, fails = 0;
   for (long k = 0; k < 1000000 && !ok && ref; k++) {
     fcm_cell_rules *r = (fcm_cell_rules *)&f;
     f.count = 0, f.fail_at = k;
-    const fcm_status st = fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &r);
+    const fcm_status st = cut_once(ctx, &cc, &r);
     f.fail_at = -1;
     if (st == FCM_OK) {
       ok = 1;
@@ -261,14 +264,11 @@ static void cut_allocation_failures_two_threads(void)
   TEST_OK(ctx, fcm_ctx_set_num_threads(ctx, 2));
   cut_case cc;
   cut_case_make(ctx, &cc);
-  fcm_mesh *mesh = cc.mesh;
-  fcm_geometry *g = cc.g;
-  fcm_surface *blade = cc.blade;
-  fcm_cell_rules *r0 = cc.r0, *ref = NULL;
+  fcm_cell_rules *ref = NULL;
   long long total = 0;
-  if (r0 && blade) {
+  if (cc.r0 && cc.blade) {
     f.count = 0;
-    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &ref));
+    TEST_OK(ctx, cut_once(ctx, &cc, &ref));
     total = f.count;
   }
   const long long live = fcm_ctx_live_allocations(ctx);
@@ -276,7 +276,7 @@ static void cut_allocation_failures_two_threads(void)
   for (long long k = 0; k < total && ref; k += 1 + total / 150) {
     fcm_cell_rules *r = (fcm_cell_rules *)&f;
     f.count = 0, f.fail_at = k;
-    const fcm_status st = fcm_cell_rules_create_cut(ctx, mesh, g, r0, blade, &r);
+    const fcm_status st = cut_once(ctx, &cc, &r);
     f.fail_at = -1;
     if (st == FCM_OK) { /* the failing allocation was not reached on this path */
       const fcm_index np = fcm_cell_rules_num_pieces(r);
