@@ -40,6 +40,9 @@ fcm_add_test(scene_surface tests/scene/surface_scene.c)
 fcm_add_test(scene_preview tests/scene/preview_scene.c)
 # The cut effect: bodies and mass in the log across cuts, cuts at t = 0, no-op cuts, errors.
 fcm_add_test(scene_cut tests/scene/cut_scene.c)
+# fcm_simulation_cut(): the reference frame the same bits as the cut effect, the deformed
+# frame carried back through an affine motion, misses, refusals, allocation failures.
+fcm_add_test(scene_cut_api tests/scene/cut_api.c)
 # Only the rule kinds a scene calls for: a static scene builds no mass rules (statistics,
 # counter, summary line "rules built"), a dynamic one does; the log's mass agrees.
 fcm_add_test(scene_rule_kinds tests/scene/rule_kinds.c)

@@ -139,7 +139,7 @@ typedef struct fcm_simulation_counters {
   long long direct_fallbacks;
   long long frames;    /**< frames written */
   fcm_index num_dofs;  /**< DOFs now (cuts add copies) */
-  int cuts;            /**< cut effects applied so far */
+  int cuts;            /**< cuts applied so far: cut effects and fcm_simulation_cut() */
   int cuts_missed;     /**< of them, cuts that missed the body (no cell got a new piece) */
   fcm_index cut_cells; /**< cells integrated again because a cut reached them (summed) */
   fcm_index pieces;    /**< separate bodies now (fcm_space_num_bodies()) */
@@ -319,6 +319,50 @@ FCM_API const fcm_cell_rules *fcm_simulation_cell_rules(const fcm_simulation *si
  * @return as fcm_integrator_step(); FCM_ERR_GEOMETRY (inverted points, "stop");
  * FCM_ERR_ARG when the run is done. */
 FCM_API fcm_status fcm_simulation_step(fcm_simulation *sim, fcm_step_info *info);
+
+/** The coordinates a blade given to fcm_simulation_cut() is in. */
+typedef enum fcm_cut_frame {
+  FCM_CUT_FRAME_REFERENCE = 0, /**< the body at rest (material coordinates), as the scene's
+                                    "cut" effects */
+  FCM_CUT_FRAME_DEFORMED = 1   /**< the body as it is now, x = X + u: each blade vertex is
+                                    carried back to the rest position of the material point it
+                                    lies on (a vertex in no material, e.g. beyond the body's
+                                    surface, by the map of the element nearest to it); the
+                                    triangles stay flat at rest, so a blade crossing a strongly
+                                    bent region is triangulated finer than the cells there */
+} fcm_cut_frame;
+
+/** What one fcm_simulation_cut() did. Seconds are wall clock; the phases are those of the
+ * counters' time_cut_* (on two threads the integrator and the solver's structure overlap). */
+typedef struct fcm_cut_info {
+  int missed;                 /**< 1: no cell got a new piece and no node a new copy */
+  fcm_index dofs_before;      /**< fcm_space_num_dofs() before the cut */
+  fcm_index dofs_after;       /**< and after it */
+  fcm_index cells_integrated; /**< cells whose rules the cut made again */
+  double seconds;             /**< the whole cut, the blade's pull-back included */
+  double seconds_rules, seconds_space, seconds_integrator, seconds_solver;
+} fcm_cut_info;
+
+/** Cut the body now along `blade`, an open or closed triangle surface (its triangles need no
+ * orientation), as a scene's "cut" effect does at its time: the cell rules, the space, the
+ * integrator and the linear solver's structure are updated from the last ones, the state
+ * carries over, and the output surface and the log follow. In the reference frame the result
+ * is the same, bit for bit, as the same blade given as a cut effect due before the next step.
+ * A blade that misses the body is no error (info->missed). Call it between steps, as often as
+ * the tool moves; every process of a distributed run calls it with the same blade.
+ * The counters count the cut (cuts, time_cut_*), and fcm_simulation_summary_view() lists it.
+ * A checkpoint cannot hold such cuts (their blades are not in the scene):
+ * fcm_simulation_write_checkpoint() refuses after one.
+ * @param[in]  blade  not kept: the caller may destroy it on return
+ * @param[out] info   may be NULL
+ * @return FCM_OK; FCM_ERR_ARG (NULL simulation or blade, a frame out of range, a scene without
+ * an embedded geometry, a blade without triangles or with non-finite vertices);
+ * FCM_ERR_UNSUPPORTED (a background refined along the cuts when they are applied,
+ * "octree": {"cuts": {"when": "cut"}}; FCM_CUT_FRAME_DEFORMED in a distributed run); the
+ * errors of a scene's cut (FCM_ERR_ALLOC, FCM_ERR_GEOMETRY, ...), after which the simulation
+ * is as it was before the call. */
+FCM_API fcm_status fcm_simulation_cut(fcm_simulation *sim, const fcm_surface *blade,
+                                      fcm_cut_frame frame, fcm_cut_info *info);
 
 /** What fcm_simulation_run() reports to its monitor after each step it took. */
 typedef struct fcm_simulation_step_event {

@@ -94,6 +94,10 @@ fcm_status fcm_simulation_write_checkpoint(fcm_simulation *S, const char *path)
   FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
             "simulation: write_checkpoint needs a simulation and a path");
   fcm_ctx *ctx = S->ctx;
+  FCM_CHECK(S->api_cuts == 0, ctx, FCM_ERR_UNSUPPORTED,
+            "checkpoint %s: the run was cut by fcm_simulation_cut() (%d times), whose blades the "
+            "scene does not hold: a resumed run could not repeat those cuts",
+            path, S->api_cuts);
   fcm_index n = fcm_integrator_num_dofs(S->integ);
   double t = 0.0;
   long long steps = 0;
@@ -448,10 +452,10 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
             "simulation: read_checkpoint needs a simulation and a path");
   fcm_ctx *ctx = S->ctx;
-  FCM_CHECK(S->c.steps == 0 && S->c.frames == 0 && !S->restored, ctx, FCM_ERR_ARG,
-            "checkpoint %s: restore into a new simulation (this one has taken %lld steps and "
-            "written %lld frames)",
-            path, S->c.steps, S->c.frames);
+  FCM_CHECK(S->c.steps == 0 && S->c.frames == 0 && S->c.cuts == 0 && !S->restored, ctx, FCM_ERR_ARG,
+            "checkpoint %s: restore into a new simulation (this one has taken %lld steps, "
+            "applied %d cuts and written %lld frames)",
+            path, S->c.steps, S->c.cuts, S->c.frames);
   st = read_file(S, path, &d);
   /* On a distributed backend (sim_backend.h) the cut replay below is collective: the
    * processes agree on the read first (a file one process cannot read fails every process

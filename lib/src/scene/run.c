@@ -531,26 +531,39 @@ static fcm_status cut_parts(fcm_simulation *S, const fcm_space *space, fcm_integ
   return st;
 }
 
-fcm_status fcm__sim_apply_cut(fcm_simulation *S)
+fcm_status fcm__sim_cut_room(fcm_simulation *S, int k)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
-  const fcm_effect *e = S->cuts[S->cuts_applied];
-  fcm_surface *surf = NULL;
+  /* each array grows from the same capacity to the same new one */
+  long long c[4] = {S->cut_cap, S->cut_cap, S->cut_cap, S->cut_cap};
+  if (k < S->cut_cap) return FCM_OK;
+  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->cut_stats, c, k + 1, sizeof *S->cut_stats));
+  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->cut_time, c + 1, k + 1, sizeof *S->cut_time));
+  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->cut_solver, c + 2, k + 1, sizeof *S->cut_solver));
+  FCM_TRY(ctx, fcm__sim_grow(ctx, (void **)&S->cut_at, c + 3, k + 1, sizeof *S->cut_at));
+  S->cut_cap = c[0];
+cleanup:
+  return st;
+}
+
+fcm_status fcm__sim_cut_along(fcm_simulation *S, const fcm_surface *surf, double at, double t0)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
   fcm_cell_rules *rules = NULL;
   fcm_space *space = NULL;
   fcm_integrator *integ = NULL;
-  const double t0 = fcm_wtime();
-  const int k = S->cuts_applied;
+  const int k = S->c.cuts; /* this cut's entry of the per-cut statistics */
   S->cut_phase[0] = S->cut_phase[1] = S->cut_phase[2] = S->cut_phase[3] = 0.0;
-  if (k == 0 && !S->refined && fcm_scene_get_background(S->scene)->octree_cuts_at_cut)
-    FCM_TRY(ctx, refine_for_cuts(S));
   /* A distributed run (the integrator has a backend, sim_backend.h): the rules keep the
    * process's cell mask, the new integrator gets the backend again (its cut hook, which
    * agrees first), and fcm__integrator_finish() at the end agrees on the outcome, so a
    * process that fails in the local work meets the others wherever they wait. */
-  FCM_TRY(ctx, fcm__sim_cut_surface(S, &e->cut, &surf));
-  S->cuts_applied++;
+  FCM_TRY(ctx, fcm__sim_cut_room(S, k));
+  S->cut_at[k] = at;
+  memset(&S->cut_stats[k], 0, sizeof S->cut_stats[k]);
+  S->cut_time[k] = S->cut_solver[k] = 0.0;
   S->c.cuts++;
   if (!surf) {
     S->c.cuts_missed++;
@@ -593,13 +606,41 @@ cleanup:
   /* a failed cut leaves the run as it was: the output surface on the space it keeps */
   if (st != FCM_OK && S->surf && space && S->surf->space == space)
     (void)fcm_embedded_surface_set_space(S->surf, S->space);
-  if (k < S->num_cuts) S->cut_time[k] = fcm_wtime() - t0, S->cut_solver[k] = S->cut_phase[3];
+  if (k < S->cut_cap) S->cut_time[k] = fcm_wtime() - t0, S->cut_solver[k] = S->cut_phase[3];
   st = fcm__integrator_finish(S->integ, st);
   fcm_integrator_destroy(&integ);
   fcm_space_destroy(&space);
   fcm_cell_rules_destroy(&rules);
+  return st;
+}
+
+fcm_status fcm__sim_apply_cut(fcm_simulation *S)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_effect *e = S->cuts[S->cuts_applied];
+  fcm_surface *surf = NULL;
+  const double t0 = fcm_wtime();
+  if (S->c.cuts == 0 && !S->refined && fcm_scene_get_background(S->scene)->octree_cuts_at_cut)
+    FCM_TRY(ctx, refine_for_cuts(S));
+  FCM_TRY(ctx, fcm__sim_cut_surface(S, &e->cut, &surf));
+  S->cuts_applied++;
+  FCM_TRY(ctx, fcm__sim_cut_along(S, surf, e->cut.time, t0));
+cleanup:
   fcm_surface_destroy(&surf);
   return st;
+}
+
+void fcm__sim_count_cut(fcm_simulation *S, double seconds)
+{
+  S->c.time_steps += seconds;
+  S->c.time_cuts += seconds;
+  S->c.time_cut_rules += S->cut_phase[0];
+  S->c.time_cut_space += S->cut_phase[1];
+  S->c.time_cut_integrator += S->cut_phase[2];
+  S->c.time_cut_solver += S->cut_phase[3];
+  S->c.time_cut_other +=
+      fmax(0.0, seconds - S->cut_phase[0] - S->cut_phase[1] - S->cut_phase[2] - S->cut_phase[3]);
 }
 
 /* The scene's cut effects in time order (stable); they need an embedded geometry. */
@@ -610,9 +651,7 @@ static fcm_status collect_cuts(fcm_simulation *S)
   const int n = fcm_scene_count_effects(S->scene, FCM_EFFECT_CUT);
   if (n == 0) return FCM_OK;
   FCM_ALLOC(ctx, (size_t)n, S->cuts);
-  FCM_ALLOC(ctx, (size_t)n, S->cut_stats);
-  FCM_ALLOC(ctx, (size_t)n, S->cut_time);
-  FCM_ALLOC(ctx, (size_t)n, S->cut_solver);
+  FCM_TRY(ctx, fcm__sim_cut_room(S, n - 1));
   for (int k = 0; k < fcm_scene_num_effects(S->scene); k++) {
     const fcm_effect *e = fcm_scene_get_effect(S->scene, k);
     if (e->type != FCM_EFFECT_CUT) continue;
@@ -836,8 +875,9 @@ void fcm_simulation_destroy(fcm_simulation **sim)
   fcm_cell_rules_destroy(&S->rules);
   fcm_geometry_destroy(&S->geom);
   fcm_mesh_destroy(&S->mesh);
-  void *arrays[] = {S->log,      S->frame_time, S->loads,        S->cuts,     S->cut_stats,
-                    S->cut_time, S->cut_solver, S->react_effect, S->react_id, S->react_log};
+  void *arrays[] = {S->log,          S->frame_time, S->loads,      S->cuts,
+                    S->cut_stats,    S->cut_time,   S->cut_solver, S->cut_at,
+                    S->react_effect, S->react_id,   S->react_log};
   for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++)
     fcm__free(ctx, arrays[k]);
   fcm__free(ctx, S);

@@ -101,6 +101,9 @@ struct fcm_simulation {
   fcm_cell_rules_stats setup_stats;
   fcm__auto_uses auto_uses; /* with quadrature.simplify = "auto" */
   fcm_cell_rules_stats *cut_stats;
+  long long cut_cap; /* entries of cut_stats, cut_time, cut_solver, cut_at */
+  double *cut_at;    /* each cut's simulated time */
+  int api_cuts;      /* of the cuts, those fcm_simulation_cut() applied */
   double *cut_time;
   double *cut_solver;  /* each cut's seconds of the linear solver's structure (of cut_time) */
   double cut_phase[4]; /* the last cut's rules, space, integrator and solver-structure seconds
@@ -179,6 +182,17 @@ void fcm__sim_count_frame(fcm_simulation_counters *c, long long step, fcm_index 
 /* Apply the next cut of the scene (S->cuts[S->cuts_applied]): rules, space, integrator and the
  * output's element map are replaced; the state carries over (run.c). */
 fcm_status fcm__sim_apply_cut(fcm_simulation *S);
+
+/* A cut along surf (reference coordinates; NULL: it missed the body's box) at simulated time
+ * `at`, started at wall time t0: the work of fcm__sim_apply_cut() after its surface, entry
+ * S->c.cuts of the per-cut statistics (run.c). */
+fcm_status fcm__sim_cut_along(fcm_simulation *S, const fcm_surface *surf, double at, double t0);
+
+/* Room for entry k of the per-cut statistics (run.c). */
+fcm_status fcm__sim_cut_room(fcm_simulation *S, int k);
+
+/* The counters' time of a cut that took `seconds` (its phases: S->cut_phase) (run.c). */
+void fcm__sim_count_cut(fcm_simulation *S, double seconds);
 
 /* The background mesh and the embedded geometry (S->mesh, S->nn, S->geom; no geometry for a
  * scene without one), the set-up's first phases; errors of the inputs name the scene section

@@ -131,15 +131,7 @@ fcm_status fcm_simulation_step(fcm_simulation *S, fcm_step_info *info)
     while (S->cuts_applied < S->num_cuts && S->cuts[S->cuts_applied]->cut.time <= t + 1e-9 * dt) {
       const double tc = fcm_wtime();
       FCM_TRY(S->ctx, fcm__sim_apply_cut(S));
-      const double cut = fcm_wtime() - tc;
-      S->c.time_steps += cut;
-      S->c.time_cuts += cut;
-      S->c.time_cut_rules += S->cut_phase[0];
-      S->c.time_cut_space += S->cut_phase[1];
-      S->c.time_cut_integrator += S->cut_phase[2];
-      S->c.time_cut_solver += S->cut_phase[3];
-      S->c.time_cut_other +=
-          fmax(0.0, cut - S->cut_phase[0] - S->cut_phase[1] - S->cut_phase[2] - S->cut_phase[3]);
+      fcm__sim_count_cut(S, fcm_wtime() - tc);
     }
   }
   double t0 = fcm_wtime();

@@ -247,20 +247,20 @@ static void rules_lines(const fcm_simulation *S, FILE *f, const fcm_cell_rules_s
  * process's, S->cut_stats) and its time. */
 static void cut_lines(const fcm_simulation *S, FILE *f, const fcm_index *cs)
 {
-  for (int k = 0; k < S->cuts_applied && S->cut_stats; k++) {
+  for (int k = 0; k < S->c.cuts && S->cut_stats; k++) {
     const fcm_cell_rules_stats *r = &S->cut_stats[k];
     fcm_index p[4] = {r->points_initial[FCM_RULE_STIFFNESS], r->points_initial[FCM_RULE_MASS],
                       r->points_simplified[FCM_RULE_STIFFNESS],
                       r->points_simplified[FCM_RULE_MASS]};
     if (cs) memcpy(p, cs + 4 * k, sizeof p);
     if (r->num_cells == 0) {
-      fprintf(f, "  cut %-5d t = %g s: missed the body's box\n", k + 1, S->cuts[k]->cut.time);
+      fprintf(f, "  cut %-5d t = %g s: missed the body's box\n", k + 1, S->cut_at[k]);
       continue;
     }
     fprintf(f,
             "  cut %-5d t = %g s: %lld cells integrated again, %lld split; their points "
             "stiffness %lld -> %lld, mass %lld -> %lld; %.3f s (rules %.3f s, solver %.3f s)\n",
-            k + 1, S->cuts[k]->cut.time, (long long)r->num_integrated, (long long)r->num_split,
+            k + 1, S->cut_at[k], (long long)r->num_integrated, (long long)r->num_split,
             (long long)p[0], (long long)p[2], (long long)p[1], (long long)p[3], S->cut_time[k],
             r->time_total, S->cut_solver[k]);
   }
@@ -500,7 +500,7 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
   double *q = NULL, body = 0.0, com[3] = {0, 0, 0};
   fcm_index *cs = NULL;
   int root = 1, com_ok = 0;
-  const fcm_index ncut = 4 * (fcm_index)S->cuts_applied; /* after the cells: the cuts' points */
+  const fcm_index ncut = 4 * (fcm_index)S->c.cuts; /* after the cells: the cuts' points */
   fcm__integrator_distributed(S->integ, &root);
   memset(&gs, 0, sizeof gs);
   /* per kind: points before / after simplification, stabilization, stored, skipped, kept
@@ -531,7 +531,7 @@ fcm_status fcm__simulation_summary_view_distributed(fcm_simulation *S, FILE *f)
     q[6 * K + 3] = (double)gs.num_slivers;
   }
   if (q) q[6 * K + 4] = (double)S->c.boundary_points; /* Nitsche's: own cells' */
-  for (int k = 0; cs && k < S->cuts_applied; k++) {
+  for (int k = 0; cs && k < S->c.cuts; k++) {
     const fcm_cell_rules_stats *r = &S->cut_stats[k];
     double *qc = q + nv + nc + 4 * k;
     qc[0] = (double)r->points_initial[FCM_RULE_STIFFNESS];

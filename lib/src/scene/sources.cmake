@@ -4,7 +4,7 @@ list(APPEND FCM_SOURCES lib/src/scene/json_adapter.c lib/src/scene/schema.c
                         lib/src/scene/parse_model.c lib/src/scene/parse_solver.c
                         lib/src/scene/view.c
                         lib/src/scene/default_scene.c
-                        lib/src/scene/run.c lib/src/scene/run_mesh.c lib/src/scene/run_effects.c
+                        lib/src/scene/run.c lib/src/scene/run_cut.c lib/src/scene/run_mesh.c lib/src/scene/run_effects.c
                         lib/src/scene/run_step.c lib/src/scene/run_output.c
                         lib/src/scene/run_summary.c lib/src/scene/checkpoint.c
                         lib/src/scene/preview.c)

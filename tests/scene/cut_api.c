@@ -1,0 +1,363 @@
+/* fcm_simulation_cut(): a host's cut between steps.
+ * - In the reference frame it is the scene's cut effect: a spinning box cut by a rectangle
+ *   through fcm_simulation_cut() after two steps has, after five, the same displacement bits,
+ *   log and counters as the same rectangle given as a cut effect due before the third step.
+ * - In the deformed frame a blade is carried back to the material: with the state set to an
+ *   affine motion x = A X + b (a rotation, then also stretches and a shear; the trilinear
+ *   elements map it exactly), the blade A B + b cut in the deformed frame gives the cut of B
+ *   at rest: the same DOFs, cells, pieces and piece volumes, and after a step the same centre
+ *   of mass (and, after the rigid motion, the same displacement to 1e-9 of its size). The
+ *   blade is a grid whose inner vertices lie in the mesh (taken by the element holding them)
+ *   and whose outer ones beyond it (taken by the nearest element's map).
+ * - A blade beyond the body is a counted miss; the run goes on.
+ * - Refused, the run unchanged: NULL arguments, a frame out of range, a blade without area, a
+ *   scene without geometry, every allocation failed in turn; a checkpoint after such a cut. */
+#include "scene_util.h"
+
+static const char *box_scene(char *buf, size_t cap, const char *effects)
+{
+  snprintf(buf, cap,
+           "{\"version\": 1, \"name\": \"cut_api\","
+           " \"background\": {\"element\": \"hex8\", \"box\": {\"min\": [-0.25, -0.25, -0.25],"
+           "   \"max\": [1.25, 0.75, 0.75]}, \"cells\": [3, 2, 2]},"
+           " \"geometry\": {\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [1, 0.5, 0.5],"
+           "   \"cells\": [2, 1, 1]},"
+           " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3,"
+           "   \"density\": 1000},"
+           " \"time\": {\"dt\": 0.02, \"steps\": 5}, \"solver\": {\"newton\": {\"rtol\": 1e-12}},"
+           " \"output\": {\"surface\": true},"
+           " \"effects\": [%s]}",
+           effects);
+  return buf;
+}
+
+static fcm_simulation *make(fcm_ctx *ctx, const char *json)
+{
+  fcm_scene *scene = NULL;
+  fcm_simulation *sim = NULL;
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "cut_api.json", &scene));
+  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  return sim;
+}
+
+static int steps(fcm_ctx *ctx, fcm_simulation *sim, int n)
+{
+  for (int k = 0; k < n; k++)
+    if (fcm_simulation_step(sim, NULL) != FCM_OK) {
+      TEST_OK(ctx, FCM_ERR_ARG);
+      return 0;
+    }
+  return 1;
+}
+
+/* The log as text without its wall_time column (the last). */
+static char *log_text(fcm_simulation *sim)
+{
+  const char *path = "cut_api_log.csv";
+  if (fcm_simulation_write_log(sim, path) != FCM_OK) return NULL;
+  FILE *f = fopen(path, "r");
+  char *text = calloc(1, 1 << 16), line[4096];
+  size_t len = 0;
+  while (f && text && fgets(line, sizeof line, f)) {
+    char *c = strrchr(line, ',');
+    if (c) *c = '\0';
+    len += (size_t)snprintf(text + len, (1 << 16) - len, "%s\n", line);
+  }
+  if (f) fclose(f);
+  remove(path);
+  return text;
+}
+
+static void reference_is_the_effect(fcm_ctx *ctx)
+{
+  char buf[4096];
+  const double center[3] = {0.55, 0.25, 0.25}, normal[3] = {1, 0, 0}, axis[3] = {0, 1, 0},
+               size[2] = {3, 3};
+  fcm_simulation *a =
+      make(ctx, box_scene(buf, sizeof buf,
+                          "{\"initial_velocity\": {\"angular_velocity\": [0, 0, 4]}},"
+                          " {\"cut\": {\"time\": 0.04, \"surface\": {\"rectangle\": {\"center\": "
+                          "[0.55, 0.25, 0.25], \"normal\": [1, 0, 0], \"axis\": [0, 1, 0], "
+                          "\"size\": [3, 3]}}}}"));
+  fcm_simulation *b = make(
+      ctx, box_scene(buf, sizeof buf, "{\"initial_velocity\": {\"angular_velocity\": [0, 0, 4]}}"));
+  fcm_surface *blade = NULL;
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, center, normal, axis, size, &blade));
+  if (a && b && blade && steps(ctx, a, 5) && steps(ctx, b, 2)) {
+    fcm_cut_info info;
+    const fcm_index n0 = fcm_space_num_dofs(fcm_simulation_space(b));
+    TEST_OK(ctx, fcm_simulation_cut(b, blade, FCM_CUT_FRAME_REFERENCE, &info));
+    TEST_TRUE(!info.missed && info.dofs_before == n0 && info.dofs_after > n0);
+    TEST_TRUE(info.dofs_after == fcm_space_num_dofs(fcm_simulation_space(b)));
+    TEST_TRUE(info.cells_integrated > 0 && info.seconds >= info.seconds_rules);
+    steps(ctx, b, 3);
+    const fcm_index n = fcm_integrator_num_dofs(fcm_simulation_integrator(a));
+    TEST_TRUE(n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)));
+    if (n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)))
+      TEST_TRUE(memcmp(fcm_integrator_displacement(fcm_simulation_integrator(a)),
+                       fcm_integrator_displacement(fcm_simulation_integrator(b)),
+                       (size_t)n * sizeof(double)) == 0);
+    char *la = log_text(a), *lb = log_text(b);
+    TEST_TRUE(la && lb && strcmp(la, lb) == 0);
+    free(la), free(lb);
+    fcm_simulation_counters ca, cb;
+    fcm_simulation_get_counters(a, &ca);
+    fcm_simulation_get_counters(b, &cb);
+    TEST_TRUE(ca.cuts == 1 && cb.cuts == 1 && cb.cuts_missed == 0 && cb.pieces == 2);
+    TEST_TRUE(ca.cut_cells == cb.cut_cells && ca.num_dofs == cb.num_dofs);
+    TEST_TRUE(cb.time_cuts > 0.0 && cb.time_cut_rules > 0.0);
+    /* the summary lists the cut, at the time it was made */
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    if (f) {
+      fcm_simulation_summary_view(b, f);
+      fclose(f);
+    }
+    TEST_TRUE(text && strstr(text, "  cut 1     t = 0.04 s: ") != NULL);
+    free(text);
+    /* a checkpoint cannot hold it */
+    TEST_ERR(ctx, fcm_simulation_write_checkpoint(b, "cut_api.ckpt"), FCM_ERR_UNSUPPORTED,
+             "fcm_simulation_cut()");
+    TEST_TRUE(access("cut_api.ckpt", F_OK) != 0);
+  }
+  fcm_surface_destroy(&blade);
+  fcm_simulation_destroy(&a);
+  fcm_simulation_destroy(&b);
+}
+
+/* A grid of (m + 1)^2 vertices on the slanted plane x = 0.45 + 0.1 y + 0.05 z over
+ * y, z in [-0.4, 0.9] (the outer ones beyond the background mesh), mapped by x -> A x + t. */
+static fcm_surface *grid_blade(fcm_ctx *ctx, const double A[9], const double t[3])
+{
+  enum { m = 4 };
+  double v[3 * (m + 1) * (m + 1)];
+  fcm_index tri[3 * 2 * m * m];
+  for (int i = 0; i <= m; i++)
+    for (int j = 0; j <= m; j++) {
+      const double y = -0.37 + 1.3 * i / m, z = -0.41 + 1.3 * j / m, x = 0.45 + 0.1 * y + 0.05 * z;
+      const double p[3] = {x, y, z};
+      for (int r = 0; r < 3; r++)
+        v[3 * (i * (m + 1) + j) + r] =
+            A[3 * r] * p[0] + A[3 * r + 1] * p[1] + A[3 * r + 2] * p[2] + t[r];
+    }
+  int k = 0;
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j < m; j++) {
+      const fcm_index a = i * (m + 1) + j, b = a + 1, c = a + m + 1, d = c + 1;
+      const fcm_index q[6] = {a, b, d, a, d, c};
+      memcpy(tri + 6 * k++, q, sizeof q);
+    }
+  fcm_surface *s = NULL;
+  TEST_OK(ctx, fcm_surface_create(ctx, (m + 1) * (m + 1), v, 2 * m * m, tri, &s));
+  return s;
+}
+
+/* Set the state of sim to x = A X + t at rest (zero velocity). */
+static void set_affine(fcm_ctx *ctx, fcm_simulation *sim, const double A[9], const double t[3])
+{
+  fcm_integrator *I = fcm_simulation_integrator(sim);
+  const fcm_space *space = fcm_simulation_space(sim);
+  const fcm_mesh *mesh = fcm_space_mesh(space);
+  const fcm_index n = fcm_integrator_num_dofs(I), ne = fcm_space_num_elements(space);
+  double *u = calloc((size_t)n, sizeof *u), *v = calloc((size_t)n, sizeof *v), X[3 * 27];
+  const int nn = fcm_element_get_info(fcm_mesh_element_type(mesh))->num_nodes;
+  for (fcm_index e = 0; u && e < ne; e++) {
+    const fcm_index *dof = fcm_space_element_dofs(space, e);
+    fcm_mesh_cell_coords(mesh, fcm_space_element_cell(space, e), X);
+    for (int a = 0; a < nn; a++)
+      for (int r = 0; r < 3; r++)
+        u[dof[a] + r] = A[3 * r] * X[3 * a] + A[3 * r + 1] * X[3 * a + 1] +
+                        A[3 * r + 2] * X[3 * a + 2] + t[r] - X[3 * a + r];
+  }
+  double tt = 0.0;
+  long long k = 0;
+  fcm_integrator_get_state(I, NULL, NULL, &tt, &k);
+  if (u && v) TEST_OK(ctx, fcm_integrator_set_state(I, u, v, tt, k));
+  free(u), free(v);
+}
+
+/* The cut of blade A B + t in the deformed frame, the state x = A X + t, against that of B at
+ * rest: the same DOFs, cells, pieces and piece volumes (1e-12), and after a step the same
+ * centre of mass (1e-12 m); with `nodal` the same displacement at every DOF (1e-9 of the
+ * largest). Not so after a strain: a node whose support holds little material takes a
+ * displacement that the rounding of its elements' rules moves (the centre of mass, weighted
+ * by the material, does not). */
+static void deformed_is_carried_back(fcm_ctx *ctx, const double A[9], const double t[3], int nodal)
+{
+  char buf[4096];
+  const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[3] = {0, 0, 0};
+  fcm_simulation *a =
+      make(ctx, box_scene(buf, sizeof buf, "{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}"));
+  fcm_simulation *b =
+      make(ctx, box_scene(buf, sizeof buf, "{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}"));
+  fcm_surface *rest = grid_blade(ctx, I3, zero), *moved = grid_blade(ctx, A, t);
+  if (a && b && rest && moved) {
+    set_affine(ctx, a, A, t);
+    set_affine(ctx, b, A, t);
+    fcm_cut_info ia, ib;
+    TEST_OK(ctx, fcm_simulation_cut(a, rest, FCM_CUT_FRAME_REFERENCE, &ia));
+    TEST_OK(ctx, fcm_simulation_cut(b, moved, FCM_CUT_FRAME_DEFORMED, &ib));
+    TEST_TRUE(!ia.missed && !ib.missed && ia.dofs_after > ia.dofs_before);
+    TEST_TRUE(ia.dofs_after == ib.dofs_after && ia.cells_integrated == ib.cells_integrated);
+    fcm_simulation_counters ca, cb;
+    fcm_simulation_get_counters(a, &ca);
+    fcm_simulation_get_counters(b, &cb);
+    TEST_TRUE(ca.pieces == 2 && cb.pieces == 2);
+    /* the same pieces, of the same volumes */
+    const fcm_cell_rules *ra = fcm_simulation_cell_rules(a), *rb = fcm_simulation_cell_rules(b);
+    const fcm_index np = fcm_cell_rules_num_pieces(ra);
+    TEST_TRUE(np == fcm_cell_rules_num_pieces(rb));
+    double vmax = 0.0, dv = 0.0;
+    for (fcm_index q = 0; q < np && np == fcm_cell_rules_num_pieces(rb); q++) {
+      TEST_TRUE(fcm_cell_rules_piece_cell(ra, q) == fcm_cell_rules_piece_cell(rb, q));
+      const double va = fcm_cell_rules_piece_volume(ra, q), vb = fcm_cell_rules_piece_volume(rb, q);
+      vmax = fmax(vmax, va), dv = fmax(dv, fabs(va - vb));
+    }
+    TEST_TRUE(vmax > 0.0 && dv <= 1e-12 * vmax);
+    steps(ctx, a, 1);
+    steps(ctx, b, 1);
+    double ma[3], mb[3];
+    TEST_OK(ctx, fcm_simulation_center_of_mass(a, ma));
+    TEST_OK(ctx, fcm_simulation_center_of_mass(b, mb));
+    for (int d = 0; d < 3; d++)
+      TEST_NEAR(ma[d], mb[d], 0.0, 1e-12);
+    if (nodal) {
+      const fcm_index n = fcm_integrator_num_dofs(fcm_simulation_integrator(a));
+      TEST_TRUE(n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)));
+      if (n == fcm_integrator_num_dofs(fcm_simulation_integrator(b))) {
+        const double *ua = fcm_integrator_displacement(fcm_simulation_integrator(a)),
+                     *ub = fcm_integrator_displacement(fcm_simulation_integrator(b));
+        double dmax = 0.0, umax = 0.0;
+        for (fcm_index i = 0; i < n; i++)
+          dmax = fmax(dmax, fabs(ua[i] - ub[i])), umax = fmax(umax, fabs(ua[i]));
+        TEST_TRUE(umax > 0.1 && dmax <= 1e-9 * umax);
+      }
+    }
+  }
+  fcm_surface_destroy(&rest);
+  fcm_surface_destroy(&moved);
+  fcm_simulation_destroy(&a);
+  fcm_simulation_destroy(&b);
+}
+
+/* A rigid motion (a turn by 0.4 about (1, 2, 2)/3 and a shift), and with stretches and a shear
+ * after the turn. */
+static void deformed_frames(fcm_ctx *ctx)
+{
+  const double c = cos(0.4), s = sin(0.4), w[3] = {1.0 / 3, 2.0 / 3, 2.0 / 3};
+  const double cross[9] = {0, -w[2], w[1], w[2], 0, -w[0], -w[1], w[0], 0};
+  const double D[9] = {1.1, 0.08, 0, 0, 0.95, 0, 0.03, 0, 1.02}, t[3] = {0.3, -0.2, 0.1};
+  double Q[9], A[9];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      Q[3 * i + j] = c * (i == j) + s * cross[3 * i + j] + (1 - c) * w[i] * w[j];
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++)
+      A[3 * i + j] = Q[3 * i] * D[j] + Q[3 * i + 1] * D[3 + j] + Q[3 * i + 2] * D[6 + j];
+  deformed_is_carried_back(ctx, Q, t, 1);
+  deformed_is_carried_back(ctx, A, t, 0);
+}
+
+static void misses_and_errors(fcm_ctx *ctx)
+{
+  char buf[4096];
+  fcm_simulation *sim =
+      make(ctx, box_scene(buf, sizeof buf, "{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}"));
+  const double far[3] = {5, 5, 5}, normal[3] = {0, 0, 1}, axis[3] = {1, 0, 0}, size[2] = {1, 1};
+  const double line[9] = {0, 0, 0, 1, 1, 1, 2, 2, 2};
+  const fcm_index tri[3] = {0, 1, 2};
+  fcm_surface *away = NULL, *flat = NULL;
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, far, normal, axis, size, &away));
+  TEST_OK(ctx, fcm_surface_create(ctx, 3, line, 1, tri, &flat));
+  if (sim && away && flat) {
+    fcm_cut_info info;
+    const fcm_index n0 = fcm_space_num_dofs(fcm_simulation_space(sim));
+    TEST_OK(ctx, fcm_simulation_cut(sim, away, FCM_CUT_FRAME_DEFORMED, &info));
+    TEST_TRUE(info.missed && info.dofs_after == n0 && info.cells_integrated == 0);
+    TEST_ERR(ctx, fcm_simulation_cut(NULL, away, FCM_CUT_FRAME_REFERENCE, NULL), FCM_ERR_ARG, "");
+    TEST_ERR(ctx, fcm_simulation_cut(sim, NULL, FCM_CUT_FRAME_REFERENCE, NULL), FCM_ERR_ARG,
+             "a blade");
+    TEST_ERR(ctx, fcm_simulation_cut(sim, away, (fcm_cut_frame)7, NULL), FCM_ERR_ARG, "frame 7");
+    TEST_ERR(ctx, fcm_simulation_cut(sim, flat, FCM_CUT_FRAME_REFERENCE, &info), FCM_ERR_GEOMETRY,
+             "the blade");
+    fcm_simulation_counters c;
+    fcm_simulation_get_counters(sim, &c);
+    TEST_TRUE(c.cuts == 1 && c.cuts_missed == 1);
+    steps(ctx, sim, 1);
+  }
+  fcm_simulation_destroy(&sim);
+  /* a scene without geometry */
+  fcm_scene *scene = NULL;
+  TEST_OK(ctx, fcm_scene_create_from_string(
+                   ctx,
+                   "{\"version\": 1, \"name\": \"plain\", \"background\": {\"element\": \"hex8\","
+                   " \"box\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]}, \"cells\": [1, 1, 1]},"
+                   " \"material\": {\"model\": \"snh\", \"young\": 1e5, \"poisson\": 0.3,"
+                   " \"density\": 1000}, \"time\": {\"dt\": 0.01, \"steps\": 1}}",
+                   "plain.json", &scene));
+  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (sim && away)
+    TEST_ERR(ctx, fcm_simulation_cut(sim, away, FCM_CUT_FRAME_REFERENCE, NULL), FCM_ERR_ARG,
+             "no embedded geometry");
+  fcm_simulation_destroy(&sim);
+  fcm_surface_destroy(&away);
+  fcm_surface_destroy(&flat);
+}
+
+/* Every allocation of a deformed-frame cut failed in turn: FCM_ERR_ALLOC, the run unchanged
+ * (its counters, its DOFs) and able to step; then the cut succeeds. */
+static void allocation_failures(void)
+{
+  failing f;
+  fcm_ctx *ctx = failing_ctx_with(&f, failing_alloc_atomic);
+  char buf[4096];
+  fcm_simulation *sim =
+      ctx ? make(ctx,
+                 box_scene(buf, sizeof buf, "{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}"))
+          : NULL;
+  const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[3] = {0, 0, 0};
+  fcm_surface *blade = ctx ? grid_blade(ctx, I3, zero) : NULL;
+  if (!sim || !blade) {
+    TEST_TRUE(0);
+  } else {
+    steps(ctx, sim, 1);
+    const fcm_index n0 = fcm_space_num_dofs(fcm_simulation_space(sim));
+    int failures = 0, done = 0;
+    for (long long k = 0; k < 100000 && !done; k++) {
+      f.count = 0;
+      f.fail_at = k;
+      const fcm_status st = fcm_simulation_cut(sim, blade, FCM_CUT_FRAME_DEFORMED, NULL);
+      f.fail_at = -1;
+      if (st == FCM_OK) {
+        done = 1;
+        break;
+      }
+      failures++;
+      TEST_TRUE(st == FCM_ERR_ALLOC);
+      fcm_ctx_error_clear(ctx);
+      fcm_simulation_counters c;
+      fcm_simulation_get_counters(sim, &c);
+      TEST_TRUE(c.cuts == 0 && fcm_space_num_dofs(fcm_simulation_space(sim)) == n0);
+      if (st != FCM_ERR_ALLOC || c.cuts != 0) break;
+    }
+    TEST_TRUE(done && failures > 20);
+    TEST_TRUE(fcm_space_num_dofs(fcm_simulation_space(sim)) > n0);
+    steps(ctx, sim, 1);
+  }
+  fcm_surface_destroy(&blade);
+  fcm_simulation_destroy(&sim);
+  fcm_ctx_destroy(&ctx);
+}
+
+int main(void)
+{
+  fcm_ctx *ctx = NULL;
+  TEST_TRUE(fcm_ctx_create(NULL, &ctx) == FCM_OK);
+  reference_is_the_effect(ctx);
+  deformed_frames(ctx);
+  misses_and_errors(ctx);
+  allocation_failures();
+  fcm_ctx_destroy(&ctx);
+  TEST_RESULT();
+}
