@@ -4,7 +4,7 @@
 # public headers and link the library as a host does (fcm::fcm), with fcm's warnings.
 # Their sources and CMake project are installed with the documentation
 # (<prefix>/share/doc/fcm/examples), where the install check builds them.
-install(FILES apps/examples/host_static.c apps/examples/host_dynamic.cpp
+install(FILES apps/examples/host_static.c apps/examples/host_cut.c apps/examples/host_dynamic.cpp
               apps/examples/host_petsc.c apps/examples/CMakeLists.txt
         DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples)
 add_executable(fcm_example_host_static apps/examples/host_static.c)
@@ -15,6 +15,14 @@ if(BUILD_TESTING)
   add_test(NAME app_example_host_static
            COMMAND fcm_example_host_static ${PROJECT_BINARY_DIR}/examples-out)
   set_tests_properties(app_example_host_static PROPERTIES LABELS app TIMEOUT 300
+                       ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")
+endif()
+add_executable(fcm_example_host_cut apps/examples/host_cut.c)
+target_link_libraries(fcm_example_host_cut PRIVATE fcm::fcm)
+target_compile_options(fcm_example_host_cut PRIVATE ${FCM_WARNINGS} ${FCM_SAN_FLAGS})
+if(BUILD_TESTING)
+  add_test(NAME app_example_host_cut COMMAND fcm_example_host_cut ${PROJECT_BINARY_DIR}/examples-out)
+  set_tests_properties(app_example_host_cut PROPERTIES LABELS app TIMEOUT 300
                        ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive;OPENBLAS_NUM_THREADS=1")
 endif()
 # host_petsc: the PETSc component as a host links it (fcm::petsc); run on 2 processes by the

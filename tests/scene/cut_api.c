@@ -8,7 +8,9 @@
  *   at rest: the same DOFs, cells, pieces and piece volumes, and after a step the same centre
  *   of mass (and, after the rigid motion, the same displacement to 1e-9 of its size). The
  *   blade is a grid whose inner vertices lie in the mesh (taken by the element holding them)
- *   and whose outer ones beyond it (taken by the nearest element's map).
+ *   and whose outer ones beyond it (taken by the nearest element's motion).
+ *   fcm_simulation_rest_positions() gives A^-1 (x - b) (1e-12) in the body, beyond it and
+ *   beyond the mesh.
  * - A blade beyond the body is a counted miss; the run goes on.
  * - Refused, the run unchanged: NULL arguments, a frame out of range, a blade without area, a
  *   scene without geometry, every allocation failed in turn; a checkpoint after such a cut. */
@@ -195,6 +197,20 @@ static void deformed_is_carried_back(fcm_ctx *ctx, const double A[9], const doub
   if (a && b && rest && moved) {
     set_affine(ctx, a, A, t);
     set_affine(ctx, b, A, t);
+    /* points carried back: in the body, in the mesh beyond it, beyond the mesh */
+    const double P[12] = {0.5, 0.25, 0.25, 0.9, 0.1, 0.45, 1.2, 0.7, -0.2, -1.0, 2.0, 3.0};
+    double x[12], Xb[12];
+    for (int i = 0; i < 4; i++)
+      for (int r = 0; r < 3; r++)
+        x[3 * i + r] =
+            A[3 * r] * P[3 * i] + A[3 * r + 1] * P[3 * i + 1] + A[3 * r + 2] * P[3 * i + 2] + t[r];
+    TEST_OK(ctx, fcm_simulation_rest_positions(b, 4, x, Xb));
+    for (int i = 0; i < 12; i++)
+      TEST_NEAR(Xb[i], P[i], 0.0, 1e-12);
+    x[4] = NAN;
+    TEST_ERR(ctx, fcm_simulation_rest_positions(b, 4, x, Xb), FCM_ERR_ARG, "point 1");
+    TEST_ERR(ctx, fcm_simulation_rest_positions(b, -1, x, Xb), FCM_ERR_ARG, "n >= 0");
+    TEST_OK(ctx, fcm_simulation_rest_positions(b, 0, NULL, NULL));
     fcm_cut_info ia, ib;
     TEST_OK(ctx, fcm_simulation_cut(a, rest, FCM_CUT_FRAME_REFERENCE, &ia));
     TEST_OK(ctx, fcm_simulation_cut(b, moved, FCM_CUT_FRAME_DEFORMED, &ib));

@@ -326,16 +326,19 @@ typedef enum fcm_cut_frame {
                                     "cut" effects */
   FCM_CUT_FRAME_DEFORMED = 1   /**< the body as it is now, x = X + u: each blade vertex is
                                     carried back to the rest position of the material point it
-                                    lies on (a vertex in no material, e.g. beyond the body's
-                                    surface, by the map of the element nearest to it); the
-                                    triangles stay flat at rest, so a blade crossing a strongly
-                                    bent region is triangulated finer than the cells there */
+                                    lies on (fcm_simulation_rest_positions()); the triangles
+                                    stay flat at rest, so a blade crossing a strongly bent
+                                    region is triangulated finer than the cells there. For a
+                                    tool swept through a moving body, cut strips in the
+                                    reference frame instead (fcm_simulation_rest_positions()) */
 } fcm_cut_frame;
 
 /** What one fcm_simulation_cut() did. Seconds are wall clock; the phases are those of the
  * counters' time_cut_* (on two threads the integrator and the solver's structure overlap). */
 typedef struct fcm_cut_info {
-  int missed;                 /**< 1: no cell got a new piece and no node a new copy */
+  int missed; /**< 1: no cell got a new piece and no node a new copy: the blade missed the
+                   body, or only extended a crack inside cells (which counts from the cut that
+                   completes it) */
   fcm_index dofs_before;      /**< fcm_space_num_dofs() before the cut */
   fcm_index dofs_after;       /**< and after it */
   fcm_index cells_integrated; /**< cells whose rules the cut made again */
@@ -363,6 +366,20 @@ typedef struct fcm_cut_info {
  * is as it was before the call. */
 FCM_API fcm_status fcm_simulation_cut(fcm_simulation *sim, const fcm_surface *blade,
                                       fcm_cut_frame frame, fcm_cut_info *info);
+
+/** Carry points of the body as it is now (x = X + u) back to the rest positions of the
+ * material points they lie on: X[3i..3i+3) for x[3i..3i+3), as FCM_CUT_FRAME_DEFORMED carries
+ * a blade's vertices (a point in no element's material by the affine motion of the element
+ * nearest to it). A tool that moves through a moving body sweeps a cut whose consecutive
+ * strips meet in the material only if each shared edge keeps the rest position it had when
+ * the tool was there: a host carries the tool's edge back at each step and cuts the strip
+ * between the last and the new rest positions in the reference frame (apps/examples/
+ * host_cut.c).
+ * @return FCM_OK; FCM_ERR_ARG (NULL, n < 0, a non-finite point); FCM_ERR_UNSUPPORTED (a
+ * distributed run); FCM_ERR_GEOMETRY (the element nearest to a point outside the body is
+ * inverted); FCM_ERR_ALLOC. */
+FCM_API fcm_status fcm_simulation_rest_positions(fcm_simulation *sim, fcm_index n, const double *x,
+                                                 double *X);
 
 /** What fcm_simulation_run() reports to its monitor after each step it took. */
 typedef struct fcm_simulation_step_event {

@@ -5,6 +5,7 @@
 #include "scene/scene_impl.h"
 
 #include "core/core_impl.h"
+#include "la/mat3.h"
 #include "embed/embed_impl.h"
 #include "sim/sim_backend.h"
 #include "fcm/element.h"
@@ -42,13 +43,46 @@ static void element_nodes(const fcm_space *space, const fcm_mesh *mesh, const do
       x[3 * a + d] = X[3 * a + d] + u[dof[a] + d];
 }
 
-/* The blade's vertices carried back to the rest positions of the material points they lie on
- * in the deformed body (x = X + u of the current space and displacement): each vertex goes to
- * the first element (ascending) whose deformed map reaches it at reference coordinates that
- * lie in the element's own material (fcm_space_point_element()); a vertex in no element's
- * material goes by the map of the element whose deformed node centroid is nearest,
- * extrapolated. The triangles are the blade's. */
-static fcm_status pull_back(fcm_simulation *S, const fcm_surface *blade, fcm_surface **out)
+/* The rest position X of the point p of the deformed body by the affine motion of element e
+ * at its reference centre c: X = X(c) + (dX/dxi) (dx/dxi)^-1 (p - x(c)), which an affine
+ * motion of the element gives exactly; far from the element a trilinear map's own
+ * extrapolation may fold over, this does not. */
+static fcm_status affine_back(fcm_simulation *S, fcm_element_type type,
+                              const fcm_element_info *info, int nn, fcm_index e, const double p[3],
+                              double X0[3])
+{
+  fcm_status st = FCM_OK;
+  double X[3 * FCM_ELEMENT_MAX_NODES], x[3 * FCM_ELEMENT_MAX_NODES], JX[9], Jx[9], Jxi[9] = {0};
+  double c[3] = {0.0, 0.0, 0.0}, xc[3], d[3], dxi[3];
+  if (info->shape != FCM_SHAPE_HEX) c[0] = c[1] = c[2] = 0.25;
+  element_nodes(S->space, S->mesh, fcm_integrator_displacement(S->integ), nn, e, X, x);
+  fcm_element_jacobian(type, X, c, JX);
+  fcm_element_jacobian(type, x, c, Jx);
+  const double det = fcm__mat3_inv(Jx, Jxi);
+  FCM_CHECK(det > 0.0 && isfinite(det), S->ctx, FCM_ERR_GEOMETRY,
+            "simulation %s: the point (%g, %g, %g) lies in no element of the deformed body, and "
+            "the element nearest to it (%lld) is inverted (det J = %g): it cannot be carried "
+            "back",
+            fcm_scene_name(S->scene), p[0], p[1], p[2], (long long)e, det);
+  fcm_element_map(type, x, c, xc);
+  fcm_element_map(type, X, c, X0);
+  for (int k = 0; k < 3; k++)
+    d[k] = p[k] - xc[k];
+  fcm__mat3_mulv(Jxi, d, dxi);
+  for (int k = 0; k < 3; k++)
+    X0[k] += JX[3 * k] * dxi[0] + JX[3 * k + 1] * dxi[1] + JX[3 * k + 2] * dxi[2];
+cleanup:
+  return st;
+}
+
+/* The points p (nv of them) of the deformed body (x = X + u of the current space and
+ * displacement) carried back to the rest positions of the material points they lie on, into
+ * rest: each point goes to the first element (ascending) whose deformed map reaches it at
+ * reference coordinates that lie in the element's own material (fcm_space_point_element());
+ * a point in no element's material (beyond the body, where a blade usually starts and ends)
+ * goes by the affine motion of the element whose deformed node centroid is nearest, taken at
+ * its centre (affine_back()). */
+static fcm_status rest_positions(fcm_simulation *S, fcm_index nv, const double *p, double *rest)
 {
   fcm_status st = FCM_OK;
   fcm_ctx *ctx = S->ctx;
@@ -57,18 +91,16 @@ static fcm_status pull_back(fcm_simulation *S, const fcm_surface *blade, fcm_sur
   const fcm_element_type type = fcm_mesh_element_type(mesh);
   const fcm_element_info *info = fcm_element_get_info(type);
   const int nn = info->num_nodes;
-  const fcm_index ne = fcm_space_num_elements(space), nv = fcm_surface_num_vertices(blade);
-  const double *u = fcm_integrator_displacement(S->integ), *p = fcm_surface_coords(blade);
-  double *box = NULL, *cen = NULL, *rest = NULL, X[3 * FCM_ELEMENT_MAX_NODES],
-         x[3 * FCM_ELEMENT_MAX_NODES];
+  const fcm_index ne = fcm_space_num_elements(space);
+  const double *u = fcm_integrator_displacement(S->integ);
+  double *box = NULL, *cen = NULL, X[3 * FCM_ELEMENT_MAX_NODES], x[3 * FCM_ELEMENT_MAX_NODES];
   fcm_index *ids = NULL, cap = 64;
   fcm_aabb_tree *tree = NULL;
   FCM_CHECK(ne > 0, ctx, FCM_ERR_GEOMETRY,
-            "simulation %s: cut: the body has no elements to carry the blade back through",
+            "simulation %s: the body has no elements to carry points back through",
             fcm_scene_name(S->scene));
   FCM_ALLOC_RAW(ctx, 6 * (size_t)ne, box);
   FCM_ALLOC_RAW(ctx, 3 * (size_t)ne, cen);
-  FCM_ALLOC_RAW(ctx, 3 * (size_t)nv, rest);
   FCM_ALLOC_RAW(ctx, (size_t)cap, ids);
   for (fcm_index e = 0; e < ne; e++) {
     double *b = box + 6 * e, size = 0.0;
@@ -82,7 +114,7 @@ static fcm_status pull_back(fcm_simulation *S, const fcm_surface *blade, fcm_sur
       size = fmax(size, b[3 + d] - b[d]);
     }
     FCM_CHECK(isfinite(size), ctx, FCM_ERR_NUMERIC,
-              "simulation %s: cut: element %lld's deformed nodes are not finite",
+              "simulation %s: element %lld's deformed nodes are not finite",
               fcm_scene_name(S->scene), (long long)e);
     for (int d = 0; d < 3; d++) /* a curved deformed face may bulge past its nodes' box */
       b[d] -= 0.25 * size, b[3 + d] += 0.25 * size;
@@ -108,7 +140,7 @@ static fcm_status pull_back(fcm_simulation *S, const fcm_surface *blade, fcm_sur
           fcm_space_point_element(space, fcm_space_element_cell(space, e), xi) == e)
         found = e;
     }
-    if (found < 0) { /* in no element's material: the nearest element's map, extrapolated */
+    if (found < 0) { /* in no element's material: the nearest element's motion at its centre */
       double best = HUGE_VAL;
       for (fcm_index e = 0; e < ne; e++) {
         double r2 = 0.0;
@@ -116,26 +148,53 @@ static fcm_status pull_back(fcm_simulation *S, const fcm_surface *blade, fcm_sur
           r2 += (cen[3 * e + d] - pi[d]) * (cen[3 * e + d] - pi[d]);
         if (r2 < best) best = r2, found = e;
       }
-      element_nodes(space, mesh, u, nn, found, X, x);
-      const fcm_status sm = fcm_element_inverse_map(NULL, type, x, pi, xi);
-      FCM_CHECK(sm == FCM_OK, ctx, FCM_ERR_GEOMETRY,
-                "simulation %s: cut: blade vertex %lld at (%g, %g, %g) lies in no element of the "
-                "deformed body, and the inverse map of the nearest one (%lld) does not reach it "
-                "(%s): a vertex far outside the body, or a degenerate deformed element",
-                fcm_scene_name(S->scene), (long long)i, pi[0], pi[1], pi[2], (long long)found,
-                fcm_status_name(sm));
+      FCM_TRY(ctx, affine_back(S, type, info, nn, found, pi, rest + 3 * i));
+      continue;
     }
     fcm_mesh_cell_coords(mesh, fcm_space_element_cell(space, found), X);
     fcm_element_map(type, X, xi, rest + 3 * i);
   }
-  FCM_TRY(ctx, fcm_surface_create(ctx, nv, rest, fcm_surface_num_triangles(blade),
-                                  fcm_surface_triangles(blade), out));
 cleanup:
   fcm_aabb_tree_destroy(&tree);
   fcm__free(ctx, box);
   fcm__free(ctx, cen);
-  fcm__free(ctx, rest);
   fcm__free(ctx, ids);
+  return st;
+}
+
+/* The blade's vertices carried back (rest_positions()); the triangles are the blade's. */
+static fcm_status pull_back(fcm_simulation *S, const fcm_surface *blade, fcm_surface **out)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = S->ctx;
+  const fcm_index nv = fcm_surface_num_vertices(blade);
+  double *rest = NULL;
+  FCM_ALLOC_RAW(ctx, 3 * (size_t)nv, rest);
+  FCM_TRY(ctx, rest_positions(S, nv, fcm_surface_coords(blade), rest));
+  FCM_TRY(ctx, fcm_surface_create(ctx, nv, rest, fcm_surface_num_triangles(blade),
+                                  fcm_surface_triangles(blade), out));
+cleanup:
+  fcm__free(ctx, rest);
+  return st;
+}
+
+fcm_status fcm_simulation_rest_positions(fcm_simulation *S, fcm_index n, const double *x, double *X)
+{
+  fcm_status st = FCM_OK;
+  FCM_CHECK(S && n >= 0 && (n == 0 || (x && X)), S ? S->ctx : NULL, FCM_ERR_ARG,
+            "simulation: rest_positions needs a simulation, n >= 0 (got %lld) and both arrays",
+            (long long)n);
+  fcm_ctx *ctx = S->ctx;
+  FCM_CHECK(!fcm__integrator_distributed(S->integ, NULL), ctx, FCM_ERR_UNSUPPORTED,
+            "simulation %s: rest_positions: a distributed run holds only its own part of the "
+            "deformed body",
+            fcm_scene_name(S->scene));
+  for (fcm_index i = 0; i < 3 * n; i++)
+    FCM_CHECK(isfinite(x[i]), ctx, FCM_ERR_ARG,
+              "simulation %s: rest_positions: point %lld is not finite (component %d: %g)",
+              fcm_scene_name(S->scene), (long long)(i / 3), (int)(i % 3), x[i]);
+  if (n > 0) FCM_TRY(ctx, rest_positions(S, n, x, X));
+cleanup:
   return st;
 }
 
