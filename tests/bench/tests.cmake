@@ -32,6 +32,11 @@ target_sources(bench_roofline PRIVATE ${PROJECT_SOURCE_DIR}/tests/bench/roofline
 # Hex8 grid around a ball of about 5k and 20k active cells (figures in lib/docs/cutting.md).
 fcm_add_test(bench_cut_update tests/bench/bench_cut_update.c LABELS bench TIMEOUT 1800)
 set_tests_properties(bench_cut_update PROPERTIES RUN_SERIAL TRUE)
+# What a cut in the deformed frame adds (fcm_simulation_rest_positions(), the cut in either
+# frame) on Dick's Bunny 3 row (figures in lib/docs/cutting.md).
+fcm_add_test(bench_cut_frame tests/bench/bench_cut_frame.c LABELS bench TIMEOUT 1800
+             ARGS ${PROJECT_SOURCE_DIR}/apps/scenes/models/cutbench_body.obj)
+set_tests_properties(bench_cut_frame PROPERTIES RUN_SERIAL TRUE)
 # Octree backgrounds refined along a sphere and the cutbench body against uniform grids of the
 # same finest cell size: cells, crossed and active cells (figures in lib/docs/octree.md).
 fcm_add_test(bench_octree_cells tests/bench/bench_octree_cells.c LABELS bench TIMEOUT 1800

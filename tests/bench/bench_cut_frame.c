@@ -1,0 +1,117 @@
+/* Benchmark: what a cut in the deformed frame adds to a cut (figures in lib/docs/cutting.md,
+ * "Cut latency: the deformed frame"). Dick's Bunny 3 row of fcm-cutbench (the generated body
+ * apps/scenes/models/cutbench_body.obj on a Hex8 grid of 6.33 mm, corotated linear, gravity,
+ * its base held; the interactive solver set), two steps, then one blade: a vertical rectangle of
+ * (M + 1)^2 vertices across the body's upper half. Timed, the best of NREP fresh runs:
+ * fcm_simulation_rest_positions() of the blade's vertices, and fcm_simulation_cut() with the
+ * blade at rest (FCM_CUT_FRAME_REFERENCE) and, on a second simulation in the same state, where
+ * the tool is (FCM_CUT_FRAME_DEFORMED), with their phases. Asserts that both cuts changed the
+ * body (the body sags by millimetres under gravity: the two blades cut it nearly alike).
+ * Usage: bench_cut_frame BODY.obj [M] (default M = 10). */
+#include "fcm/fcm.h"
+#include "test.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+#define NREP 3
+
+static fcm_ctx *ctx;
+static char json[4096];
+
+static fcm_simulation *bunny(void)
+{
+  fcm_scene *scene = NULL;
+  fcm_simulation *sim = NULL;
+  TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "bench_cut_frame.json", &scene));
+  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  for (int k = 0; sim && k < 2; k++)
+    TEST_OK(ctx, fcm_simulation_step(sim, NULL));
+  return sim;
+}
+
+int main(int argc, char **argv)
+{
+  if (argc < 2) {
+    fprintf(stderr, "usage: bench_cut_frame BODY.obj [M]\n");
+    return 2;
+  }
+  const int M = argc > 2 ? atoi(argv[2]) : 10;
+  TEST_TRUE(fcm_ctx_create(NULL, &ctx) == FCM_OK && M >= 1 && M <= 200);
+  snprintf(
+      json, sizeof json,
+      "{\"version\": 1, \"name\": \"bench_cut_frame\","
+      " \"background\": {\"element\": \"hex8\", \"fit_background\": {\"cell_size\": "
+      "0.00632898, \"margin\": 0.00316449}},"
+      " \"geometry\": {\"surface\": \"%s\", \"fill_holes\": false},"
+      " \"material\": {\"model\": \"corotated_linear\", \"young\": 1e5, \"poisson\": 0.4,"
+      "  \"density\": 1000},"
+      " \"quadrature\": {\"stiffness_on_mass_space\": true},"
+      " \"solver\": {\"method\": \"multigrid\", \"fixed_cycles\": 3, \"multigrid\": {\"cycle\": "
+      "\"v\", \"blocks\": \"element\", \"block_fraction\": 0.5, \"block_sweep\": \"one_way\","
+      " \"point_sweep\": \"one_way\", \"coarse_interval\": 4}, \"newton\": "
+      "{\"fixed_iterations\": 1, \"project_psd\": true}},"
+      " \"time\": {\"dt\": 0.01, \"steps\": 9}, \"output\": {\"frame_interval\": 1000},"
+      " \"effects\": [{\"gravity\": {\"acceleration\": [0, -9.81, 0]}},"
+      "  {\"fixed\": {\"region\": {\"half_space\": {\"point\": [0, 0.0162311, 0], \"normal\": "
+      "[0, -1, 0]}}}}]}",
+      argv[1]);
+  /* the blade: x = 0.003, y in [0.06, 0.2], z in [-0.07, 0.07] */
+  const int nv = (M + 1) * (M + 1), nt = 2 * M * M;
+  double *v = malloc(3 * (size_t)nv * sizeof *v), *rest = malloc(3 * (size_t)nv * sizeof *rest);
+  fcm_index *tri = malloc(3 * (size_t)nt * sizeof *tri);
+  fcm_surface *blade = NULL;
+  for (int i = 0; v && i <= M; i++)
+    for (int j = 0; j <= M; j++) {
+      double *p = v + 3 * (i * (M + 1) + j);
+      p[0] = 0.003, p[1] = 0.06 + 0.14 * i / M, p[2] = -0.07 + 0.14 * j / M;
+    }
+  for (int i = 0, k = 0; tri && i < M; i++)
+    for (int j = 0; j < M; j++, k++) {
+      const fcm_index a = i * (M + 1) + j, b = a + 1, c = a + M + 1, d = c + 1;
+      const fcm_index q[6] = {a, b, d, a, d, c};
+      for (int r = 0; r < 6; r++)
+        tri[6 * k + r] = q[r];
+    }
+  if (v && tri) TEST_OK(ctx, fcm_surface_create(ctx, nv, v, nt, tri, &blade));
+  double best_pull = 1e300, best_ref = 1e300, best_def = 1e300;
+  fcm_cut_info ref = {0}, def = {0};
+  fcm_index elements = 0;
+  for (int rep = 0; rep < NREP && blade && rest; rep++) {
+    fcm_simulation *a = bunny(), *b = bunny();
+    if (!a || !b) {
+      fcm_simulation_destroy(&a);
+      fcm_simulation_destroy(&b);
+      break;
+    }
+    elements = fcm_space_num_elements(fcm_simulation_space(b));
+    double t0 = fcm_wtime();
+    TEST_OK(ctx, fcm_simulation_rest_positions(b, nv, v, rest));
+    const double pull = fcm_wtime() - t0;
+    fcm_cut_info ia, ib;
+    TEST_OK(ctx, fcm_simulation_cut(a, blade, FCM_CUT_FRAME_REFERENCE, &ia));
+    TEST_OK(ctx, fcm_simulation_cut(b, blade, FCM_CUT_FRAME_DEFORMED, &ib));
+    TEST_TRUE(!ia.missed && !ib.missed);
+    if (pull < best_pull) best_pull = pull;
+    if (ia.seconds < best_ref) best_ref = ia.seconds, ref = ia;
+    if (ib.seconds < best_def) best_def = ib.seconds, def = ib;
+    fcm_simulation_destroy(&a);
+    fcm_simulation_destroy(&b);
+  }
+  printf("Bunny 3 row after two steps, %lld elements; a blade of %d vertices, %d triangles; "
+         "best of %d\n",
+         (long long)elements, nv, nt, NREP);
+  printf("  fcm_simulation_rest_positions() of its vertices: %.4f s\n", best_pull);
+  const fcm_cut_info *c[2] = {&ref, &def};
+  const char *name[2] = {"reference frame", "deformed frame "};
+  for (int k = 0; k < 2; k++)
+    printf("  cut, %s: %.4f s (rules %.4f, space %.4f, integrator %.4f, solver %.4f), "
+           "%lld cells, %lld -> %lld DOFs\n",
+           name[k], c[k]->seconds, c[k]->seconds_rules, c[k]->seconds_space,
+           c[k]->seconds_integrator, c[k]->seconds_solver, (long long)c[k]->cells_integrated,
+           (long long)c[k]->dofs_before, (long long)c[k]->dofs_after);
+  fcm_surface_destroy(&blade);
+  free(v), free(rest), free(tri);
+  fcm_ctx_destroy(&ctx);
+  TEST_RESULT();
+}
