@@ -18,6 +18,8 @@
 
 static fcm_ctx *ctx;
 static char json[4096];
+static fcm_scene *scenes[2 * NREP]; /* read by their simulations for their life */
+static int num_scenes;
 
 static fcm_simulation *bunny(void)
 {
@@ -25,6 +27,10 @@ static fcm_simulation *bunny(void)
   fcm_simulation *sim = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "bench_cut_frame.json", &scene));
   if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (num_scenes < 2 * NREP)
+    scenes[num_scenes++] = scene;
+  else
+    fcm_scene_destroy(&scene);
   for (int k = 0; sim && k < 2; k++)
     TEST_OK(ctx, fcm_simulation_step(sim, NULL));
   return sim;
@@ -111,6 +117,8 @@ int main(int argc, char **argv)
            c[k]->seconds_integrator, c[k]->seconds_solver, (long long)c[k]->cells_integrated,
            (long long)c[k]->dofs_before, (long long)c[k]->dofs_after);
   fcm_surface_destroy(&blade);
+  while (num_scenes > 0)
+    fcm_scene_destroy(&scenes[--num_scenes]);
   free(v), free(rest), free(tri);
   fcm_ctx_destroy(&ctx);
   TEST_RESULT();

@@ -33,13 +33,28 @@ static const char *box_scene(char *buf, size_t cap, const char *effects)
   return buf;
 }
 
+/* The scenes of the simulations made so far (a simulation reads its scene for its life):
+ * destroyed by drop_scenes() once those simulations are. */
+static fcm_scene *scenes[16];
+static int num_scenes;
+
 static fcm_simulation *make(fcm_ctx *ctx, const char *json)
 {
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "cut_api.json", &scene));
   if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (scene && num_scenes < 16)
+    scenes[num_scenes++] = scene;
+  else
+    fcm_scene_destroy(&scene);
   return sim;
+}
+
+static void drop_scenes(void)
+{
+  while (num_scenes > 0)
+    fcm_scene_destroy(&scenes[--num_scenes]);
 }
 
 static int steps(fcm_ctx *ctx, fcm_simulation *sim, int n)
@@ -126,6 +141,7 @@ static void reference_is_the_effect(fcm_ctx *ctx)
   fcm_surface_destroy(&blade);
   fcm_simulation_destroy(&a);
   fcm_simulation_destroy(&b);
+  drop_scenes();
 }
 
 /* A grid of (m + 1)^2 vertices on the slanted plane x = 0.45 + 0.1 y + 0.05 z over
@@ -255,6 +271,7 @@ static void deformed_is_carried_back(fcm_ctx *ctx, const double A[9], const doub
   fcm_surface_destroy(&moved);
   fcm_simulation_destroy(&a);
   fcm_simulation_destroy(&b);
+  drop_scenes();
 }
 
 /* A rigid motion (a turn by 0.4 about (1, 2, 2)/3 and a shift), and with stretches and a shear
@@ -303,6 +320,7 @@ static void misses_and_errors(fcm_ctx *ctx)
     steps(ctx, sim, 1);
   }
   fcm_simulation_destroy(&sim);
+  drop_scenes();
   /* a scene without geometry */
   fcm_scene *scene = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(
@@ -317,6 +335,7 @@ static void misses_and_errors(fcm_ctx *ctx)
     TEST_ERR(ctx, fcm_simulation_cut(sim, away, FCM_CUT_FRAME_REFERENCE, NULL), FCM_ERR_ARG,
              "no embedded geometry");
   fcm_simulation_destroy(&sim);
+  fcm_scene_destroy(&scene);
   fcm_surface_destroy(&away);
   fcm_surface_destroy(&flat);
 }
@@ -363,6 +382,7 @@ static void allocation_failures(void)
   }
   fcm_surface_destroy(&blade);
   fcm_simulation_destroy(&sim);
+  drop_scenes();
   fcm_ctx_destroy(&ctx);
 }
 

@@ -63,6 +63,22 @@ class Simulation(FcmObject):
         run and is raised. Returns True when the run is done."""
         return _fcm.simulation_run(self._h, monitor)
 
+    def cut(self, blade, frame="reference"):
+        """Cut the body now along `blade` (a :class:`~fcm.geometry.Surface`), as a scene's cut
+        effect does (``fcm_simulation_cut``): frame "reference" (the blade at rest) or
+        "deformed" (where the tool is now; its vertices carried back to rest). Returns the
+        cut's report (missed, dofs_before, dofs_after, cells_integrated, seconds and its
+        phases) as a dict."""
+        frames = {"reference": 0, "deformed": 1}
+        if frame not in frames:
+            raise ValueError(f"cut: frame must be 'reference' or 'deformed', got {frame!r}")
+        return _fcm.simulation_cut(self._h, blade._h, frames[frame])
+
+    def rest_positions(self, x):
+        """Points of the body as it is now, (n, 3), carried back to the rest positions of the
+        material points they lie on (``fcm_simulation_rest_positions``): a new (n, 3) array."""
+        return _fcm.simulation_rest_positions(self._h, np.asarray(x, dtype=float))
+
     @property
     def info(self):
         """done, step_count, num_steps, frame_due, state_finite."""

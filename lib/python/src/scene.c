@@ -180,7 +180,62 @@ static PyObject *simulation_write(PyObject *self, PyObject *args)
   Py_RETURN_NONE;
 }
 
-PyMethodDef fcmpy_scene_methods[] = {{"scene_create", scene_create, METH_VARARGS, NULL},
+/* fcm_simulation_cut(): (simulation, surface, frame 0 or 1) -> fcm_cut_info as a dict. */
+static PyObject *simulation_cut(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *simh, *surfh;
+  int frame;
+  if (!PyArg_ParseTuple(args, "OOi", &simh, &surfh, &frame)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
+  const fcm_surface *blade = h ? fcmpy_get(surfh, FCMPY_SURFACE) : NULL;
+  if (!blade) return NULL;
+  fcm_cut_info info;
+  fcmpy_pin(h);
+  PyThreadState *gil = PyEval_SaveThread();
+  const fcm_status st = fcm_simulation_cut(h->ptr, blade, (fcm_cut_frame)frame, &info);
+  PyEval_RestoreThread(gil);
+  fcmpy_unpin(h);
+  if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
+  return Py_BuildValue("{s:O,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:d}", "missed",
+                       info.missed ? Py_True : Py_False, "dofs_before",
+                       (long long)info.dofs_before, "dofs_after", (long long)info.dofs_after,
+                       "cells_integrated", (long long)info.cells_integrated, "seconds",
+                       info.seconds, "seconds_rules", info.seconds_rules, "seconds_space",
+                       info.seconds_space, "seconds_integrator", info.seconds_integrator,
+                       "seconds_solver", info.seconds_solver);
+}
+
+/* fcm_simulation_rest_positions(): (simulation, x (n, 3)) -> X (n, 3). */
+static PyObject *simulation_rest_positions(PyObject *self, PyObject *args)
+{
+  (void)self;
+  PyObject *simh, *xo;
+  if (!PyArg_ParseTuple(args, "OO", &simh, &xo)) return NULL;
+  fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
+  if (!h) return NULL;
+  PyArrayObject *x = fcmpy_input(xo, NPY_DOUBLE, 2, 3, "points");
+  if (!x) return NULL;
+  npy_intp dims[2] = {PyArray_DIM(x, 0), 3};
+  PyObject *X = PyArray_SimpleNew(2, dims, NPY_DOUBLE);
+  if (!X) {
+    Py_DECREF(x);
+    return NULL;
+  }
+  const fcm_status st = fcm_simulation_rest_positions(h->ptr, dims[0], PyArray_DATA(x),
+                                                      PyArray_DATA((PyArrayObject *)X));
+  Py_DECREF(x);
+  if (st != FCM_OK) {
+    Py_DECREF(X);
+    return fcmpy_raise(h->ctx, st);
+  }
+  return X;
+}
+
+PyMethodDef fcmpy_scene_methods[] = {{"simulation_cut", simulation_cut, METH_VARARGS, NULL},
+                                     {"simulation_rest_positions", simulation_rest_positions,
+                                      METH_VARARGS, NULL},
+                                     {"scene_create", scene_create, METH_VARARGS, NULL},
                                      {"scene_info", scene_info, METH_O, NULL},
                                      {"simulation_create", simulation_create, METH_VARARGS, NULL},
                                      {"simulation_run", simulation_run, METH_VARARGS, NULL},

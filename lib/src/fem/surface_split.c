@@ -131,9 +131,11 @@ static fcm_status cache_parts(fcm_embedded_surface *es, const fcm__embed_polys *
   FCM_ALLOC_RAW(ctx, 3 * polys->nx + 3, copy.x);
   FCM_ALLOC_RAW(ctx, polys->n + 1, copy.nv);
   FCM_ALLOC_RAW(ctx, polys->n + 1, copy.piece);
-  memcpy(copy.x, polys->x, 3 * polys->nx * sizeof *copy.x);
-  memcpy(copy.nv, polys->nv, polys->n * sizeof *copy.nv);
-  memcpy(copy.piece, polys->piece, polys->n * sizeof *copy.piece);
+  if (polys->nx > 0) memcpy(copy.x, polys->x, 3 * polys->nx * sizeof *copy.x);
+  if (polys->n > 0) { /* none: a cut that split no boundary triangle */
+    memcpy(copy.nv, polys->nv, polys->n * sizeof *copy.nv);
+    memcpy(copy.piece, polys->piece, polys->n * sizeof *copy.piece);
+  }
   copy.n = copy.cap = polys->n;
   copy.nx = copy.capx = polys->nx;
   fcm__embed_polys_free(ctx, &es->polys);
@@ -372,8 +374,8 @@ static fcm_status mark_split(fcm_embedded_surface *es, const unsigned char *chan
   }
   FCM_TRY(ctx, cut_crossings(es, extends, split)); /* the cuts' triangles alone decide */
   FCM_TRY(ctx, preclip_pairs(es, split, maybe, qcell, pc));
-  qsort(pairs, (size_t)n, 2 * sizeof *pairs,
-        fcm__surface_cmp_pair); /* one cell's parts made once */
+  if (n > 1) /* one cell's parts made once */
+    qsort(pairs, (size_t)n, 2 * sizeof *pairs, fcm__surface_cmp_pair);
   size_t kc = 0;
   for (fcm_index k = 0; k < n; k++) {
     const fcm_index c = pairs[2 * k], i = pairs[2 * k + 1];
@@ -437,7 +439,8 @@ static fcm_status split_triangles(fcm_embedded_surface *es, const unsigned char 
     for (size_t k = 0; k < nids; k++, n++)
       pairs[2 * n] = ids[k], pairs[2 * n + 1] = t;
   }
-  qsort(pairs, n, 2 * sizeof *pairs, fcm__surface_cmp_pair); /* one cell's parts made once */
+  if (n > 1) /* one cell's parts made once (no pairs: a cut that split no boundary triangle) */
+    qsort(pairs, n, 2 * sizeof *pairs, fcm__surface_cmp_pair);
   FCM_ALLOC_RAW(ctx, n + 1, poff);
   FCM_ALLOC_RAW(ctx, n + 1, xoff);
   for (size_t k = 0, j = 0, jp = 0; k < n; k++) {
