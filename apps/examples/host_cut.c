@@ -58,7 +58,9 @@ int main(int argc, char **argv)
   fcm_surface *blade = NULL;
   if (fcm_ctx_create(NULL, &ctx) != FCM_OK) return 1;
   CHECK(fcm_scene_create_from_string(ctx, beam_json, "host_cut", &scene));
-  CHECK(fcm_simulation_create(ctx, scene, NULL, &sim));
+  fcm_simulation_options so = fcm_simulation_options_default();
+  so.host_cuts = 1; /* each cut integrates only the elements it changes */
+  CHECK(fcm_simulation_create(ctx, scene, &so, &sim));
   CHECK(fcm_simulation_write_frame(sim, dir, 0));
   double last[6] = {0}; /* the edge's ends at rest, where the last strip ended */
   while (!fcm_simulation_done(sim)) {

@@ -26,7 +26,9 @@ static fcm_simulation *bunny(void)
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "bench_cut_frame.json", &scene));
-  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  fcm_simulation_options so = fcm_simulation_options_default();
+  so.host_cuts = 1;
+  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, &so, &sim));
   if (num_scenes < 2 * NREP)
     scenes[num_scenes++] = scene;
   else

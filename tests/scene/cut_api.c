@@ -38,17 +38,28 @@ static const char *box_scene(char *buf, size_t cap, const char *effects)
 static fcm_scene *scenes[16];
 static int num_scenes;
 
-static fcm_simulation *make(fcm_ctx *ctx, const char *json)
+static int checkpoint_interval = FCM_DEFAULT; /* of the simulations make_with() makes */
+
+static fcm_simulation *make_with(fcm_ctx *ctx, const char *json, int host_cuts)
 {
   fcm_scene *scene = NULL;
   fcm_simulation *sim = NULL;
+  fcm_simulation_options o = fcm_simulation_options_default();
+  o.host_cuts = host_cuts;
+  o.checkpoint_interval = checkpoint_interval;
   TEST_OK(ctx, fcm_scene_create_from_string(ctx, json, "cut_api.json", &scene));
-  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, NULL, &sim));
+  if (scene) TEST_OK(ctx, fcm_simulation_create(ctx, scene, &o, &sim));
   if (scene && num_scenes < 16)
     scenes[num_scenes++] = scene;
   else
     fcm_scene_destroy(&scene);
   return sim;
+}
+
+/* A simulation of the scene whose host will cut it. */
+static fcm_simulation *make(fcm_ctx *ctx, const char *json)
+{
+  return make_with(ctx, json, 1);
 }
 
 static void drop_scenes(void)
@@ -85,7 +96,8 @@ static char *log_text(fcm_simulation *sim)
   return text;
 }
 
-static void reference_is_the_effect(fcm_ctx *ctx)
+/* host_cuts 1: the cut keeps the elements it leaves (the same bits); 0: integrates all. */
+static void reference_is_the_effect(fcm_ctx *ctx, int host_cuts)
 {
   char buf[4096];
   const double center[3] = {0.55, 0.25, 0.25}, normal[3] = {1, 0, 0}, axis[3] = {0, 1, 0},
@@ -96,8 +108,9 @@ static void reference_is_the_effect(fcm_ctx *ctx)
                           " {\"cut\": {\"time\": 0.04, \"surface\": {\"rectangle\": {\"center\": "
                           "[0.55, 0.25, 0.25], \"normal\": [1, 0, 0], \"axis\": [0, 1, 0], "
                           "\"size\": [3, 3]}}}}"));
-  fcm_simulation *b = make(
-      ctx, box_scene(buf, sizeof buf, "{\"initial_velocity\": {\"angular_velocity\": [0, 0, 4]}}"));
+  fcm_simulation *b = make_with(
+      ctx, box_scene(buf, sizeof buf, "{\"initial_velocity\": {\"angular_velocity\": [0, 0, 4]}}"),
+      host_cuts);
   fcm_surface *blade = NULL;
   TEST_OK(ctx, fcm_surface_create_rectangle(ctx, center, normal, axis, size, &blade));
   if (a && b && blade && steps(ctx, a, 5) && steps(ctx, b, 2)) {
@@ -292,6 +305,103 @@ static void deformed_frames(fcm_ctx *ctx)
   deformed_is_carried_back(ctx, A, t, 0);
 }
 
+/* A scene whose cut effect is due at t = 0 (applied at the set-up) saves and restores as
+ * before; a simulation cut by the host neither saves (fcm_simulation_checkpoint_due() 0 from
+ * then on) nor restores. */
+static void checkpoints(fcm_ctx *ctx)
+{
+  char buf[4096];
+  const char *cut0 = "{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}, {\"cut\": {\"surface\": "
+                     "{\"plane\": {\"point\": [0.55, 0, 0], \"normal\": [1, 0, 0]}}}}";
+  fcm_simulation *a = make(ctx, box_scene(buf, sizeof buf, cut0));
+  fcm_simulation *b = make(ctx, box_scene(buf, sizeof buf, cut0));
+  if (a && b && steps(ctx, a, 1)) {
+    TEST_OK(ctx, fcm_simulation_write_checkpoint(a, "cut_api_t0.ckpt"));
+    TEST_OK(ctx, fcm_simulation_read_checkpoint(b, "cut_api_t0.ckpt"));
+    steps(ctx, a, 1);
+    steps(ctx, b, 1);
+    const fcm_index n = fcm_integrator_num_dofs(fcm_simulation_integrator(a));
+    TEST_TRUE(n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)) &&
+              memcmp(fcm_integrator_displacement(fcm_simulation_integrator(a)),
+                     fcm_integrator_displacement(fcm_simulation_integrator(b)),
+                     (size_t)n * sizeof(double)) == 0);
+  }
+  fcm_simulation_destroy(&a);
+  fcm_simulation_destroy(&b);
+  checkpoint_interval = 1;
+  a = make(ctx, box_scene(buf, sizeof buf, "{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}"));
+  checkpoint_interval = FCM_DEFAULT;
+  const double center[3] = {0.55, 0.25, 0.25}, normal[3] = {1, 0, 0}, axis[3] = {0, 1, 0},
+               size[2] = {3, 3};
+  fcm_surface *blade = NULL;
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, center, normal, axis, size, &blade));
+  if (a && blade && steps(ctx, a, 1)) {
+    TEST_TRUE(fcm_simulation_checkpoint_due(a) == 1);
+    TEST_OK(ctx, fcm_simulation_cut(a, blade, FCM_CUT_FRAME_REFERENCE, NULL));
+    TEST_ERR(ctx, fcm_simulation_read_checkpoint(a, "cut_api_t0.ckpt"), FCM_ERR_ARG,
+             "fcm_simulation_cut()");
+    steps(ctx, a, 1);
+    TEST_TRUE(fcm_simulation_checkpoint_due(a) == 0);
+  }
+  remove("cut_api_t0.ckpt");
+  fcm_surface_destroy(&blade);
+  fcm_simulation_destroy(&a);
+  drop_scenes();
+}
+
+/* The element search of the pull-back under a state no element maps affinely (a smooth
+ * nonlinear field at the nodes): 200 material points of the body, pushed forward through their
+ * own element, come back to within 1e-11 (an affine state, exact from any element, cannot
+ * tell a wrong element from the right one). */
+static void element_search(fcm_ctx *ctx)
+{
+  char buf[4096];
+  fcm_simulation *sim =
+      make(ctx, box_scene(buf, sizeof buf, "{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}"));
+  if (!sim) return;
+  fcm_integrator *I = fcm_simulation_integrator(sim);
+  const fcm_space *space = fcm_simulation_space(sim);
+  const fcm_mesh *mesh = fcm_space_mesh(space);
+  const fcm_index n = fcm_integrator_num_dofs(I), ne = fcm_space_num_elements(space);
+  double *u = calloc((size_t)n, sizeof *u), *v = calloc((size_t)n, sizeof *v), X[24];
+  for (fcm_index e = 0; u && e < ne; e++) {
+    const fcm_index *dof = fcm_space_element_dofs(space, e);
+    fcm_mesh_cell_coords(mesh, fcm_space_element_cell(space, e), X);
+    for (int a = 0; a < 8; a++) {
+      const double x = X[3 * a], y = X[3 * a + 1], z = X[3 * a + 2];
+      u[dof[a]] = 0.1 * sin(3 * y) + 0.05 * z * z;
+      u[dof[a] + 1] = 0.15 * x * x + 0.05 * sin(2 * z);
+      u[dof[a] + 2] = -0.2 * x * x * (1 + y);
+    }
+  }
+  double t = 0.0, worst = 0.0;
+  long long k = 0;
+  fcm_integrator_get_state(I, NULL, NULL, &t, &k);
+  if (u && v) TEST_OK(ctx, fcm_integrator_set_state(I, u, v, t, k));
+  rng r = {12345};
+  for (int i = 0; u && i < 200; i++) {
+    const double P[3] = {0.5 + 0.49 * rng_uniform(&r), 0.25 + 0.24 * rng_uniform(&r),
+                         0.25 + 0.24 * rng_uniform(&r)};
+    fcm_index cell;
+    double xi[3], xn[24], p[3], R[3];
+    TEST_OK(ctx, fcm_space_locate(space, 1, P, &cell, xi, NULL));
+    const fcm_index e = fcm_space_point_element(space, cell, xi);
+    const fcm_index *dof = fcm_space_element_dofs(space, e);
+    fcm_mesh_cell_coords(mesh, cell, X);
+    for (int a = 0; a < 8; a++)
+      for (int c = 0; c < 3; c++)
+        xn[3 * a + c] = X[3 * a + c] + u[dof[a] + c];
+    fcm_element_map(FCM_ELEMENT_HEX8, xn, xi, p);
+    TEST_OK(ctx, fcm_simulation_rest_positions(sim, 1, p, R));
+    for (int c = 0; c < 3; c++)
+      worst = fmax(worst, fabs(R[c] - P[c]));
+  }
+  TEST_TRUE(worst <= 1e-11);
+  free(u), free(v);
+  fcm_simulation_destroy(&sim);
+  drop_scenes();
+}
+
 static void misses_and_errors(fcm_ctx *ctx)
 {
   char buf[4096];
@@ -390,7 +500,10 @@ int main(void)
 {
   fcm_ctx *ctx = NULL;
   TEST_TRUE(fcm_ctx_create(NULL, &ctx) == FCM_OK);
-  reference_is_the_effect(ctx);
+  reference_is_the_effect(ctx, 1);
+  reference_is_the_effect(ctx, 0);
+  checkpoints(ctx);
+  element_search(ctx);
   deformed_frames(ctx);
   misses_and_errors(ctx);
   allocation_failures();

@@ -90,6 +90,11 @@ typedef struct fcm_simulation_options {
   fcm_setup_phase_fn setup_phase;              /**< called when each set-up phase starts and ends
                                                     (fcm_setup_phase_event); NULL (default): none */
   void *setup_phase_user;                      /**< its argument; default NULL */
+  int host_cuts; /**< 1: the host will cut the body with fcm_simulation_cut(): the integrator
+                      keeps what a cut reuses, as for a scene with cut effects (each element's
+                      mass block and load vectors, nn (nn + 1) / 2 + 3 nn doubles per load), so
+                      that a cut integrates only the elements it changes; 0 (default): only for
+                      a scene with cut effects (a host's cut then integrates every element) */
 } fcm_simulation_options;
 
 /** Defaults as documented on each member. */
@@ -305,7 +310,8 @@ FCM_API void fcm_simulation_preview_view(const fcm_scene *scene,
 FCM_API void fcm_simulation_destroy(fcm_simulation **sim);
 
 /** The cell rules of the embedded geometry (statistics: fcm_cell_rules_get_stats()), NULL
- * for a scene without geometry. Valid for the life of the simulation. */
+ * for a scene without geometry. Valid until the next cut (a step that applies a cut effect,
+ * or fcm_simulation_cut()), which replaces them, as it does the space and the integrator. */
 FCM_API const fcm_cell_rules *fcm_simulation_cell_rules(const fcm_simulation *sim);
 
 /** Advance one step (fcm_integrator_step()) and record it for the log and the counters (the
@@ -327,14 +333,15 @@ typedef enum fcm_cut_frame {
   FCM_CUT_FRAME_DEFORMED = 1   /**< the body as it is now, x = X + u: each blade vertex is
                                     carried back to the rest position of the material point it
                                     lies on (fcm_simulation_rest_positions()); the triangles
-                                    stay flat at rest, so a blade crossing a strongly bent
-                                    region is triangulated finer than the cells there. For a
-                                    tool swept through a moving body, cut strips in the
-                                    reference frame instead (fcm_simulation_rest_positions()) */
+                                    stay flat at rest. Bent back, a blade is no longer flat: one
+                                    triangulated finer than the cells costs more and may be
+                                    refused (lib/docs/cutting.md). For a tool swept through a
+                                    moving body, cut strips in the reference frame instead */
 } fcm_cut_frame;
 
 /** What one fcm_simulation_cut() did. Seconds are wall clock; the phases are those of the
- * counters' time_cut_* (on two threads the integrator and the solver's structure overlap). */
+ * counters' time_cut_* (on two threads the integrator and the solver's structure overlap);
+ * seconds_rules includes the blade's check and, in the deformed frame, its pull-back. */
 typedef struct fcm_cut_info {
   int missed; /**< 1: no cell got a new piece and no node a new copy: the blade missed the
                    body, or only extended a crack inside cells (which counts from the cut that
@@ -351,33 +358,41 @@ typedef struct fcm_cut_info {
  * integrator and the linear solver's structure are updated from the last ones, the state
  * carries over, and the output surface and the log follow. In the reference frame the result
  * is the same, bit for bit, as the same blade given as a cut effect due before the next step.
- * A blade that misses the body is no error (info->missed). Call it between steps, as often as
- * the tool moves; every process of a distributed run calls it with the same blade.
+ * A cut integrates only the elements it changes when the simulation was created with
+ * fcm_simulation_options.host_cuts (or its scene has cut effects). A blade that misses the
+ * body is no error (info->missed). Call it between steps, as often as the tool moves; every
+ * process of a distributed run calls it with the same blade. The pointers the simulation gave
+ * before (fcm_simulation_integrator(), _space(), _cell_rules()) are replaced.
  * The counters count the cut (cuts, time_cut_*), and fcm_simulation_summary_view() lists it.
  * A checkpoint cannot hold such cuts (their blades are not in the scene):
- * fcm_simulation_write_checkpoint() refuses after one.
+ * fcm_simulation_write_checkpoint() refuses after one, and fcm_simulation_checkpoint_due() is
+ * 0 from then on.
  * @param[in]  blade  not kept: the caller may destroy it on return
  * @param[out] info   may be NULL
  * @return FCM_OK; FCM_ERR_ARG (NULL simulation or blade, a frame out of range, a scene without
- * an embedded geometry, a blade without triangles or with non-finite vertices);
- * FCM_ERR_UNSUPPORTED (a background refined along the cuts when they are applied,
- * "octree": {"cuts": {"when": "cut"}}; FCM_CUT_FRAME_DEFORMED in a distributed run); the
- * errors of a scene's cut (FCM_ERR_ALLOC, FCM_ERR_GEOMETRY, ...), after which the simulation
- * is as it was before the call. */
+ * an embedded geometry); FCM_ERR_GEOMETRY (a blade whose triangles all lack area, or the
+ * errors of fcm_simulation_rest_positions()); FCM_ERR_UNSUPPORTED (a background refined along
+ * the cuts when they are applied, "octree": {"cuts": {"when": "cut"}};
+ * FCM_CUT_FRAME_DEFORMED in a distributed run); the errors of a scene's cut (FCM_ERR_ALLOC,
+ * FCM_ERR_GEOMETRY, ...). A failure before the new space takes over leaves the simulation as
+ * it was, its counters included; one after it (the log's blocks) leaves the body cut. */
 FCM_API fcm_status fcm_simulation_cut(fcm_simulation *sim, const fcm_surface *blade,
                                       fcm_cut_frame frame, fcm_cut_info *info);
 
 /** Carry points of the body as it is now (x = X + u) back to the rest positions of the
  * material points they lie on: X[3i..3i+3) for x[3i..3i+3), as FCM_CUT_FRAME_DEFORMED carries
- * a blade's vertices (a point in no element's material by the affine motion of the element
- * nearest to it). A tool that moves through a moving body sweeps a cut whose consecutive
- * strips meet in the material only if each shared edge keeps the rest position it had when
- * the tool was there: a host carries the tool's edge back at each step and cuts the strip
- * between the last and the new rest positions in the reference frame (apps/examples/
- * host_cut.c).
+ * a blade's vertices. A point goes by the first element (in the space's order) whose deformed
+ * map reaches it inside the element's cell (in a cell that cuts split, inside its piece); a
+ * point in no such element by the affine motion, at its centre, of the element whose deformed
+ * node centroid is nearest. A tool that moves through a moving body sweeps a cut whose
+ * consecutive strips meet in the material only if each shared edge keeps the rest position it
+ * had when the tool was there: a host carries the tool's edge back at each step and cuts the
+ * strip between the last and the new rest positions in the reference frame
+ * (apps/examples/host_cut.c).
  * @return FCM_OK; FCM_ERR_ARG (NULL, n < 0, a non-finite point); FCM_ERR_UNSUPPORTED (a
- * distributed run); FCM_ERR_GEOMETRY (the element nearest to a point outside the body is
- * inverted); FCM_ERR_ALLOC. */
+ * distributed run); FCM_ERR_NUMERIC (a non-finite deformed node); FCM_ERR_GEOMETRY (a body
+ * without elements, or the element nearest to a point outside the body inverted);
+ * FCM_ERR_ALLOC. */
 FCM_API fcm_status fcm_simulation_rest_positions(fcm_simulation *sim, fcm_index n, const double *x,
                                                  double *X);
 

@@ -44,13 +44,14 @@ class Scene(FcmObject):
 
 class Simulation(FcmObject):
     """A scene's pipeline: geometry, cell rules, space, integrator, effects.
-    ``Simulation(ctx, scene, max_steps=DEFAULT)``; then :meth:`step` in a host loop, or
-    :meth:`run` with a monitor called after every step."""
+    ``Simulation(ctx, scene, max_steps=DEFAULT, host_cuts=False)``; then :meth:`step` in a host
+    loop, or :meth:`run` with a monitor called after every step. host_cuts: the host will
+    :meth:`cut` the body (each cut then integrates only the elements it changes)."""
 
     __slots__ = ("scene",)
 
-    def __init__(self, ctx, scene, max_steps=DEFAULT):
-        super().__init__(_fcm.simulation_create(ctx, scene, int(max_steps)))
+    def __init__(self, ctx, scene, max_steps=DEFAULT, host_cuts=False):
+        super().__init__(_fcm.simulation_create(ctx, scene, int(max_steps), bool(host_cuts)))
         self.scene = scene
 
     def step(self):

@@ -40,12 +40,14 @@ static PyObject *simulation_create(PyObject *self, PyObject *args)
   (void)self;
   PyObject *ch, *sh;
   long long max_steps;
-  if (!PyArg_ParseTuple(args, "OOL", &ch, &sh, &max_steps)) return NULL;
+  int host_cuts = 0;
+  if (!PyArg_ParseTuple(args, "OOL|p", &ch, &sh, &max_steps, &host_cuts)) return NULL;
   fcmpy_handle *c = fcmpy_handle_of(ch, FCMPY_CTX);
   const fcm_scene *scene = c ? fcmpy_get(sh, FCMPY_SCENE) : NULL;
   if (!scene) return NULL;
   fcm_simulation_options o = fcm_simulation_options_default();
   o.max_steps = (fcm_index)max_steps;
+  o.host_cuts = host_cuts;
   fcm_simulation *sim = NULL;
   fcmpy_handle *scene_h = fcmpy_handle_of(sh, FCMPY_SCENE);
   fcmpy_pin(c);
@@ -188,22 +190,23 @@ static PyObject *simulation_cut(PyObject *self, PyObject *args)
   int frame;
   if (!PyArg_ParseTuple(args, "OOi", &simh, &surfh, &frame)) return NULL;
   fcmpy_handle *h = fcmpy_handle_of(simh, FCMPY_SIMULATION);
-  const fcm_surface *blade = h ? fcmpy_get(surfh, FCMPY_SURFACE) : NULL;
-  if (!blade) return NULL;
+  fcmpy_handle *bh = h ? fcmpy_handle_of(surfh, FCMPY_SURFACE) : NULL;
+  if (!bh) return NULL;
   fcm_cut_info info;
-  fcmpy_pin(h);
+  fcmpy_pin(h); /* both stay open while the GIL is released */
+  fcmpy_pin(bh);
   PyThreadState *gil = PyEval_SaveThread();
-  const fcm_status st = fcm_simulation_cut(h->ptr, blade, (fcm_cut_frame)frame, &info);
+  const fcm_status st = fcm_simulation_cut(h->ptr, bh->ptr, (fcm_cut_frame)frame, &info);
   PyEval_RestoreThread(gil);
+  fcmpy_unpin(bh);
   fcmpy_unpin(h);
   if (st != FCM_OK) return fcmpy_raise(h->ctx, st);
-  return Py_BuildValue("{s:O,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:d}", "missed",
-                       info.missed ? Py_True : Py_False, "dofs_before",
-                       (long long)info.dofs_before, "dofs_after", (long long)info.dofs_after,
-                       "cells_integrated", (long long)info.cells_integrated, "seconds",
-                       info.seconds, "seconds_rules", info.seconds_rules, "seconds_space",
-                       info.seconds_space, "seconds_integrator", info.seconds_integrator,
-                       "seconds_solver", info.seconds_solver);
+  return Py_BuildValue(
+      "{s:O,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:d}", "missed", info.missed ? Py_True : Py_False,
+      "dofs_before", (long long)info.dofs_before, "dofs_after", (long long)info.dofs_after,
+      "cells_integrated", (long long)info.cells_integrated, "seconds", info.seconds,
+      "seconds_rules", info.seconds_rules, "seconds_space", info.seconds_space,
+      "seconds_integrator", info.seconds_integrator, "seconds_solver", info.seconds_solver);
 }
 
 /* fcm_simulation_rest_positions(): (simulation, x (n, 3)) -> X (n, 3). */
@@ -232,14 +235,14 @@ static PyObject *simulation_rest_positions(PyObject *self, PyObject *args)
   return X;
 }
 
-PyMethodDef fcmpy_scene_methods[] = {{"simulation_cut", simulation_cut, METH_VARARGS, NULL},
-                                     {"simulation_rest_positions", simulation_rest_positions,
-                                      METH_VARARGS, NULL},
-                                     {"scene_create", scene_create, METH_VARARGS, NULL},
-                                     {"scene_info", scene_info, METH_O, NULL},
-                                     {"simulation_create", simulation_create, METH_VARARGS, NULL},
-                                     {"simulation_run", simulation_run, METH_VARARGS, NULL},
-                                     {"simulation_info", simulation_info, METH_O, NULL},
-                                     {"simulation_state", simulation_state, METH_O, NULL},
-                                     {"simulation_write", simulation_write, METH_VARARGS, NULL},
-                                     {NULL, NULL, 0, NULL}};
+PyMethodDef fcmpy_scene_methods[] = {
+    {"simulation_cut", simulation_cut, METH_VARARGS, NULL},
+    {"simulation_rest_positions", simulation_rest_positions, METH_VARARGS, NULL},
+    {"scene_create", scene_create, METH_VARARGS, NULL},
+    {"scene_info", scene_info, METH_O, NULL},
+    {"simulation_create", simulation_create, METH_VARARGS, NULL},
+    {"simulation_run", simulation_run, METH_VARARGS, NULL},
+    {"simulation_info", simulation_info, METH_O, NULL},
+    {"simulation_state", simulation_state, METH_O, NULL},
+    {"simulation_write", simulation_write, METH_VARARGS, NULL},
+    {NULL, NULL, 0, NULL}};

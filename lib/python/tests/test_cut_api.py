@@ -34,7 +34,7 @@ def rectangle(ctx, scratch):
 def test_cut_between_steps_is_the_effect(ctx, scratch):
     path = blade_file(scratch)
     a = fcm.Simulation(ctx, fcm.Scene.from_string(ctx, BOX % (CUT % path), "a"))
-    b = fcm.Simulation(ctx, fcm.Scene.from_string(ctx, BOX % "", "b"))
+    b = fcm.Simulation(ctx, fcm.Scene.from_string(ctx, BOX % "", "b"), host_cuts=True)
     a.run()
     b.step()
     b.step()

@@ -452,10 +452,11 @@ fcm_status fcm_simulation_read_checkpoint(fcm_simulation *S, const char *path)
   FCM_CHECK(S && path && path[0], S ? S->ctx : NULL, FCM_ERR_ARG,
             "simulation: read_checkpoint needs a simulation and a path");
   fcm_ctx *ctx = S->ctx;
-  FCM_CHECK(S->c.steps == 0 && S->c.frames == 0 && S->c.cuts == 0 && !S->restored, ctx, FCM_ERR_ARG,
+  FCM_CHECK(S->c.steps == 0 && S->c.frames == 0 && S->api_cuts == 0 && !S->restored, ctx,
+            FCM_ERR_ARG,
             "checkpoint %s: restore into a new simulation (this one has taken %lld steps, "
-            "applied %d cuts and written %lld frames)",
-            path, S->c.steps, S->c.cuts, S->c.frames);
+            "been cut %d times by fcm_simulation_cut() and written %lld frames)",
+            path, S->c.steps, S->api_cuts, S->c.frames);
   st = read_file(S, path, &d);
   /* On a distributed backend (sim_backend.h) the cut replay below is collective: the
    * processes agree on the read first (a file one process cannot read fails every process
@@ -506,7 +507,7 @@ cleanup:
 
 int fcm_simulation_checkpoint_due(const fcm_simulation *S)
 {
-  if (!S || S->c.steps == 0) return 0;
+  if (!S || S->c.steps == 0 || S->api_cuts > 0) return 0; /* such a run cannot be saved */
   int every = S->opts.checkpoint_interval >= 0
                   ? S->opts.checkpoint_interval
                   : fcm_scene_get_output(S->scene)->checkpoint_interval;

@@ -624,6 +624,7 @@ fcm_status fcm__sim_apply_cut(fcm_simulation *S)
   if (S->c.cuts == 0 && !S->refined && fcm_scene_get_background(S->scene)->octree_cuts_at_cut)
     FCM_TRY(ctx, refine_for_cuts(S));
   FCM_TRY(ctx, fcm__sim_cut_surface(S, &e->cut, &surf));
+  FCM_TRY(ctx, fcm__sim_cut_room(S, S->c.cuts)); /* the cut is counted once it is consumed */
   S->cuts_applied++;
   FCM_TRY(ctx, fcm__sim_cut_along(S, surf, e->cut.time, t0));
 cleanup:
@@ -694,8 +695,9 @@ static fcm_status build_integrator(fcm_simulation *S)
   S->c.nonfinite_first_step = -1;
   S->c.contact_min_distance = HUGE_VAL;
   fcm_integrator_options io = integrator_options(S);
-  /* a scene with cuts: each cut integrates only the elements it changes, on the old arrays */
-  if (S->rules && fcm_scene_count_effects(scene, FCM_EFFECT_CUT) > 0)
+  /* a scene with cuts, or a host that will cut: each cut integrates only the elements it
+   * changes, on the old arrays */
+  if (S->rules && (fcm_scene_count_effects(scene, FCM_EFFECT_CUT) > 0 || S->opts.host_cuts))
     io.cut_reuse |= FCM_CUT_REUSE_BLOCKS | FCM_CUT_REUSE_STORAGE;
   S->c.inertia = io.kind == FCM_INTEGRATOR_BACKWARD_EULER;
   S->c.damping = io.rayleigh_mass > 0.0 || io.rayleigh_stiffness > 0.0;

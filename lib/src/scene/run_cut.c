@@ -78,10 +78,11 @@ cleanup:
 /* The points p (nv of them) of the deformed body (x = X + u of the current space and
  * displacement) carried back to the rest positions of the material points they lie on, into
  * rest: each point goes to the first element (ascending) whose deformed map reaches it at
- * reference coordinates that lie in the element's own material (fcm_space_point_element());
- * a point in no element's material (beyond the body, where a blade usually starts and ends)
- * goes by the affine motion of the element whose deformed node centroid is nearest, taken at
- * its centre (affine_back()). */
+ * reference coordinates that lie in the element's cell, and in a cell that cuts split, in the
+ * element's piece (fcm_space_point_element(): the piece of the nearest authentic quadrature
+ * point); a point in no such element (beyond the mesh's active cells, where a blade usually
+ * starts and ends) goes by the affine motion of the element whose deformed node centroid is
+ * nearest, taken at its centre (affine_back(); a scan of the elements per such point). */
 static fcm_status rest_positions(fcm_simulation *S, fcm_index nv, const double *p, double *rest)
 {
   fcm_status st = FCM_OK;
@@ -232,13 +233,16 @@ fcm_status fcm_simulation_cut(fcm_simulation *S, const fcm_surface *blade, fcm_c
   if (frame == FCM_CUT_FRAME_DEFORMED) FCM_TRY(ctx, pull_back(S, blade, &rest));
   const fcm_space *before = S->space;
   st = fcm__sim_cut_along(S, rest ? rest : blade, fcm_integrator_time(S->integ), t0);
-  if (st != FCM_OK) {
-    if (S->space == before) S->c = c0; /* the run is as it was: its counters too */
+  if (st != FCM_OK && S->space == before) {
+    S->c = c0; /* the run is as it was: its counters too */
     goto cleanup;
   }
+  /* the body is cut (a failure after the new space took over, e.g. the log's blocks, still
+   * leaves it cut): counted, and kept out of checkpoints */
   S->api_cuts++;
   const double seconds = fcm_wtime() - t0;
   fcm__sim_count_cut(S, seconds);
+  if (st != FCM_OK) goto cleanup;
   if (info) {
     const fcm_cell_rules_stats *r = &S->cut_stats[S->c.cuts - 1];
     info->missed = S->c.cuts_missed > c0.cuts_missed;

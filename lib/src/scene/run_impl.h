@@ -91,13 +91,15 @@ struct fcm_simulation {
    * (mutable) user pointer, so the scene's const effects are never cast */
   fcm_effect *loads;
   int num_loads;
-  /* cuts ("cut" effects) in time order; the first cuts_applied are in the rules */
+  /* the scene's cuts ("cut" effects) in time order; the first cuts_applied of them have been
+   * applied (the rules hold them, with the host's cuts: fcm_simulation_cut()) */
   int num_cuts, cuts_applied;
   const fcm_effect **cuts;
   /* The rule statistics of the set-up (a cut replaces the rules, whose statistics are then
-   * the cut's) and of each cut applied (cut_stats[k], num_cuts entries: the cells that cut
-   * integrated again; zero for a cut whose surface missed the body's box), with its wall
-   * time (cut_time[k]: rules, space and integrator), for the summary. */
+   * the cut's) and of each cut applied, the scene's and the host's in the order they came
+   * (cut_stats[k], k < c.cuts: the cells that cut integrated again; zero for a cut whose
+   * surface missed the body's box), with its wall time (cut_time[k]: rules, space and
+   * integrator), for the summary. */
   fcm_cell_rules_stats setup_stats;
   fcm__auto_uses auto_uses; /* with quadrature.simplify = "auto" */
   fcm_cell_rules_stats *cut_stats;
