@@ -152,8 +152,7 @@ static fcm_status rest_positions(fcm_simulation *S, fcm_index nv, const double *
       FCM_TRY(ctx, affine_back(S, type, info, nn, found, pi, rest + 3 * i));
       continue;
     }
-    fcm_mesh_cell_coords(mesh, fcm_space_element_cell(space, found), X);
-    fcm_element_map(type, X, xi, rest + 3 * i);
+    fcm_element_map(type, X, xi, rest + 3 * i); /* X: the found element's cell, from the search */
   }
 cleanup:
   fcm_aabb_tree_destroy(&tree);
