@@ -72,7 +72,10 @@ typedef enum fcm_cell_moments {
                                      geometry's volume mesh. It applies to affine background
                                      cells of a whole geometry (not a crop) that no cut reaches,
                                      when simplify is not OFF; elsewhere, and for a cell whose fit
-                                     fails, the VOLUME path (counted in the statistics) */
+                                     fails, the VOLUME path (counted in the statistics), which
+                                     for a geometry without a volume mesh starts from the cell
+                                     split by the boundary triangles into parts inside and
+                                     outside the body */
   FCM_CELL_MOMENTS_VOLUME = 1,  /**< clip the geometry's cells into tets, map a tet rule onto
                                     each, simplify (the path of every cell before the surface one) */
   FCM_CELL_MOMENTS_SURFACE = 2, /**< as AUTO, but a cell whose fit fails is an error

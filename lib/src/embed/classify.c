@@ -341,7 +341,10 @@ static int surface_pays(const build *B, size_t candidates)
 #define SURFACE_EMPTY_FRACTION 1e-13
 
 /* A cut cell on the surface path: its one piece fitted on the surface moments, or, when the
- * fit fails, built by the volume path (FCM_CELL_MOMENTS_AUTO) or refused (SURFACE). */
+ * fit fails, built by the volume path (FCM_CELL_MOMENTS_AUTO) or refused (SURFACE). The volume
+ * path starts from the volume mesh's tets in the cell, or without one from the cell split by
+ * the body's boundary triangles into parts wholly inside or outside the body (as a cut piece
+ * whose fit fails). */
 static fcm_status surface_rules(const build *B, const fcm__embed_cell *cell, fcm__embed_ws *ws,
                                 const double box[6], cell_out *o, cell_sums *sums)
 {
@@ -355,19 +358,26 @@ static fcm_status surface_rules(const build *B, const fcm__embed_cell *cell, fcm
   sums->counts.surface_cells++;
   if (ok) goto cleanup;
   sums->counts.surface_fallbacks++;
-  FCM_CHECK(B->o->moments != FCM_CELL_MOMENTS_SURFACE && B->geom->num_cells > 0, ctx,
-            FCM_ERR_NUMERIC,
+  FCM_CHECK(B->o->moments != FCM_CELL_MOMENTS_SURFACE, ctx, FCM_ERR_NUMERIC,
             "embed: background cell %lld: no positive rule of at most M points on candidates "
-            "inside the material carries its surface moments (volume fraction %.3g; %s)%s",
-            (long long)cell->id, o->volume / cell->volume, why,
-            B->geom->num_cells > 0 ? "; moments = auto falls back to the volume mesh"
-                                   : " and the geometry has no volume mesh to fall back on");
-  FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, cell, B->o->clip_rtol, B->o->sliver_rtol,
-                                    ws, &sums->counts, &vol));
+            "inside the material carries its surface moments (volume fraction %.3g; %s); "
+            "moments = auto would fall back to the volume path",
+            (long long)cell->id, o->volume / cell->volume, why);
+  if (B->geom->num_cells > 0) {
+    FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, cell, B->o->clip_rtol,
+                                      B->o->sliver_rtol, ws, &sums->counts, &vol));
+  } else {
+    if (!ws->parts) FCM_ALLOC(ctx, 1, ws->parts);
+    FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, B->o->clip_rtol,
+                                       B->o->sliver_rtol, ws, ws->parts, NULL, NULL));
+    ws->num_tets = 0;
+    if (ws->parts->n > 0)
+      FCM_TRY(ctx, fcm__embed_piece_body_tets(ctx, cell, ws->parts, 0, ws, &vol));
+  }
   FCM_CHECK(ws->num_tets > 0, ctx, FCM_ERR_NUMERIC,
-            "embed: background cell %lld: the fit on its surface moments failed and its volume "
-            "mesh has no material in it (volume fraction %.3g by the surface)",
-            (long long)cell->id, o->volume / cell->volume);
+            "embed: background cell %lld: the fit on its surface moments failed (%s) and the "
+            "volume path finds no material in it (volume fraction %.3g by the surface)",
+            (long long)cell->id, why, o->volume / cell->volume);
   FCM_TRY(ctx, fcm__embed_map_piece(B, cell, ws, o->pc));
 cleanup:
   return st;

@@ -833,7 +833,9 @@ fcm_status fcm__embed_split_lumps(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm
 /* Surface body (P->mat): the parts of piece `piece` split by the body's boundary triangles
  * that meet the cell into parts wholly inside or outside the body; the inside ones
  * fan-tetrahedralized into ws->tets (as fcm__embed_piece_tets), their volume *volume. The
- * volume path's start for a piece whose surface fit fails. */
+ * volume path's start for a piece whose surface fit fails. Tets below their part's sliver volume
+ * are dropped, unless every tet is (a piece that holds more than a sliver in all): then each
+ * of positive volume is kept. */
 fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell, fcm__parts *P,
                                       int piece, fcm__embed_ws *ws, double *volume);
 

@@ -574,9 +574,12 @@ fcm_status fcm__embed_piece_body_tets(fcm_ctx *ctx, const fcm__embed_cell *cell,
   FCM_TRY(ctx, fcm__embed_parts_copy(ctx, P, piece, Q));
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, P->mat->tree, cell->lo, cell->hi, &P->mat->buf));
   FCM_TRY(ctx, body_split(ctx, P->mat, cell, P->mat->buf.ids, P->mat->buf.n, Q));
-  for (size_t i = 0; i < Q->n; i++)
-    FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, Q->poly + i, Q->vmin[i], volume, &lost, &moved,
-                                        &nslivers));
+  /* the tets above their parts' sliver volume; a piece kept for its material (above the
+   * pieces' sliver volume) can hold none, when its every tet is below: then all of them */
+  for (int slivers = 0; slivers < 2 && ws->num_tets == 0; slivers++)
+    for (size_t i = 0; i < Q->n; i++)
+      FCM_TRY(ctx, fcm__embed_append_tets(ctx, ws, Q->poly + i, slivers ? 0.0 : Q->vmin[i], volume,
+                                          &lost, &moved, &nslivers));
 cleanup:
   if (Q) fcm__embed_parts_free(ctx, Q);
   fcm__free(ctx, Q);
