@@ -186,8 +186,8 @@ int main(void)
              (long long)S->num_surface_fallbacks);
       TEST_TRUE(fcm_cell_rules_num_pieces(r2) > fcm_cell_rules_num_pieces(r1));
       TEST_TRUE(S->num_surface_fallbacks > 0);
-      const double K = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) /
-                       (double)fcm_mesh_num_cells(mesh);
+      const double K =
+          (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / (double)fcm_mesh_num_cells(mesh);
       int small = 0, whole = 0;
       for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(r2); p++) {
         int np;
@@ -254,7 +254,8 @@ int main(void)
       x[3 * i + 1] = cos(rb) * q1 - sin(rb) * p2 + 0.021;
       x[3 * i + 2] = sin(rb) * q1 + cos(rb) * p2 - 0.017;
     }
-    const fcm_index tc[24] = {0, 1, 3, 7, 0, 3, 2, 7, 0, 2, 6, 7, 0, 6, 4, 7, 0, 4, 5, 7, 0, 5, 1, 7};
+    const fcm_index tc[24] = {0, 1, 3, 7, 0, 3, 2, 7, 0, 2, 6, 7,
+                              0, 6, 4, 7, 0, 4, 5, 7, 0, 5, 1, 7};
     fcm_geometry *slab = NULL, *ssurf = NULL;
     fcm_surface *ss = NULL;
     TEST_OK(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, 8, x, 6, tc, &slab));
