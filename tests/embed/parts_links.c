@@ -47,7 +47,7 @@ static void add_tri(scene *s, const double a[3], const double b[3], const double
   double x[3][3];
   TEST_TRUE(s->n < 64);
   map(a, x[0]), map(b, x[1]), map(c, x[2]);
-  if (fcm__embed_cut_tri_setup(x[0], x[1], x[2], 0, inner ? inner : none, NULL, s->t + s->n))
+  if (fcm__embed_cut_tri_setup(x[0], x[1], x[2], 0, inner ? inner : none, NULL, NULL, s->t + s->n))
     s->n++;
 }
 

@@ -269,6 +269,9 @@ typedef struct fcm_cell_rules_stats {
                             surface rule carries (their traction or Nitsche terms are lost);
                             embedded_area + dropped_area is the surface's area. Computed only
                             when surface rules are built (surface_strength >= 0), else 0 */
+  double split_change; /**< the largest change of a cell's parts' volume by the cuts'
+                            splitting, relative to the cell's volume (rounding, about 1e-15;
+                            above 1e-12 in the cells num_degenerate counts) */
 } fcm_cell_rules_stats;
 
 /** Per-cell quadrature of an embedded geometry in a background mesh (opaque). */

@@ -235,6 +235,7 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
   fcm_cell_rules *R = NULL;
   unsigned char *inner = NULL;
   fcm_index *ref = NULL;
+  fcm__cut_wall *walls = NULL;
   FCM_CHECK(rules, ctx, FCM_ERR_ARG, "embed cut: output pointer is NULL");
   *rules = NULL;
   FCM_CHECK(ctx && mesh && geom && prev && cut, ctx, FCM_ERR_ARG,
@@ -255,7 +256,8 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
   const fcm_index *tv = fcm_surface_triangles(cut);
   FCM_ALLOC(ctx, 3 * (size_t)nt + 1, inner);
   FCM_ALLOC(ctx, (size_t)nt + 1, ref);
-  FCM_TRY(ctx, fcm__embed_cut_inner_edges(ctx, cut, inner, ref));
+  FCM_ALLOC(ctx, 3 * (size_t)nt + 1, walls);
+  FCM_TRY(ctx, fcm__embed_cut_inner_edges(ctx, cut, inner, ref, walls));
   /* A cut that meets the parts of some cell in a way the tolerances cannot resolve (the
    * splitting changes their volume) is shifted by a small deterministic translation and
    * applied again: 1e-7, 1e-6, then 1e-5 of the mean cell size, along a fixed direction
@@ -279,8 +281,9 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
           v[k][j] = x[3 * tv[3 * t + k] + j] + d * dir[j];
           w[k][j] = x[3 * tv[3 * ref[t] + k] + j] + d * dir[j];
         }
-      R->num_cut_tris += fcm__embed_cut_tri_setup(v[0], v[1], v[2], prev->num_cuts, inner + 3 * t,
-                                                  &w[0][0], R->cut_tris + R->num_cut_tris);
+      R->num_cut_tris +=
+          fcm__embed_cut_tri_setup(v[0], v[1], v[2], prev->num_cuts, inner + 3 * t, &w[0][0],
+                                   walls + 3 * t, R->cut_tris + R->num_cut_tris);
     }
     R->num_cuts = prev->num_cuts + 1;
     R->prev_num_pieces = prev->num_pieces;
@@ -291,9 +294,9 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
     st = build_rules(ctx, mesh, geom, prev, prev->num_cut_tris, keep, NULL, R);
     R->opts.cell_mask = NULL;
     FCM_TRY(ctx, st);
-    degenerate = R->stats.num_degenerate;
     for (int j = 0; j < 3; j++)
       R->stats.cut_shift[j] = d * dir[j];
+    degenerate = R->stats.num_degenerate;
     R->stats.cut_attempts = attempt + 1;
     if (degenerate == 0) break;
   }
@@ -305,13 +308,14 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
   FCM_CHECK(degenerate == 0, ctx, FCM_ERR_GEOMETRY,
             "embed cut: the cut meets %lld cell(s) in a degenerate way that shifts of up to %g "
             "(1e-5 of the mean cell size %g) did not resolve: splitting them changes their "
-            "volume; move the cut",
-            (long long)degenerate, shift[CUT_ATTEMPTS - 1] * h, h);
+            "volume (by up to %.3g of a cell's); move the cut",
+            (long long)degenerate, shift[CUT_ATTEMPTS - 1] * h, h, R->stats.split_change);
   *rules = R;
   R = NULL;
 cleanup:
   fcm__free(ctx, inner);
   fcm__free(ctx, ref);
+  fcm__free(ctx, walls);
   fcm_cell_rules_destroy(&R);
   return st;
 }

@@ -207,6 +207,7 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
     sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
+    sums->counts.split_change = fmax(sums->counts.split_change, P->split_error / cell->volume);
   }
   FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
   if (B->prev) {
@@ -640,6 +641,7 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
       sums->counts.sliver_volume += mine.counts.sliver_volume;
       sums->counts.moved_volume += mine.counts.moved_volume;
       sums->counts.degenerate += mine.counts.degenerate;
+      sums->counts.split_change = fmax(sums->counts.split_change, mine.counts.split_change);
       sums->counts.surface_cells += mine.counts.surface_cells;
       sums->counts.surface_fallbacks += mine.counts.surface_fallbacks;
       sums->counts.kept += mine.counts.kept;

@@ -22,7 +22,8 @@ fcm_status fcm__embed_cut_candidates(fcm_ctx *ctx, const fcm_aabb_tree *cut_tree
 }
 
 int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
-                             const unsigned char inner[3], const double *ref, fcm__cut_tri *t)
+                             const unsigned char inner[3], const double *ref,
+                             const fcm__cut_wall *walls, fcm__cut_tri *t)
 {
   memcpy(t->inner, inner, sizeof t->inner);
   double e0[3], e1[3], n[3], l2 = 0.0;
@@ -64,6 +65,11 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
   for (int k = 0; k < 3; k++) {
     const double *p = t->x[k], *q = t->x[(k + 1) % 3];
     double e[3], m[3];
+    if (walls && walls[k].through) { /* the wall shared with the edge's other triangle */
+      memcpy(t->edge[k].n, walls[k].n, sizeof t->edge[k].n);
+      t->edge[k].d = fcm__vec3_dot(t->edge[k].n, walls[k].through == 1 ? p : q);
+      continue;
+    }
     for (int d = 0; d < 3; d++)
       e[d] = q[d] - p[d];
     fcm__vec3_cross(e, t->plane.n,
@@ -123,8 +129,36 @@ static double tri_area2(const double *x, const fcm_index *tv, fcm_index t)
   return sqrt(fcm__vec3_dot(n, n));
 }
 
+/* The wall of edge E[0] / E[1] (the same vertices a < b, slots of triangles s and r with unit
+ * normals ns, nr) into walls, when the two are not a fold: their normals, s's and r's taken
+ * with orientations that agree along the edge, within 60 degrees. */
+static void shared_wall(const double *x, const fcm_index *tv, const edge_key *E, const double *ns,
+                        const double *nr, fcm__cut_wall *walls)
+{
+  const fcm_index ss = E[0].slot, sr = E[1].slot;
+  /* edge k of a triangle runs from its vertex k to k + 1: consistent orientations run the
+   * shared edge in opposite directions */
+  const int s_fwd = tv[ss] == E[0].a, r_fwd = tv[sr] == E[1].a;
+  const double sg = s_fwd != r_fwd ? 1.0 : -1.0;
+  double m[3], e[3], w[3];
+  for (int d = 0; d < 3; d++)
+    m[d] = ns[d] + sg * nr[d];
+  if (!(fcm__vec3_dot(ns, nr) * sg >= 0.5)) return;
+  for (int d = 0; d < 3; d++) /* along s's edge: e x n points out of s */
+    e[d] = s_fwd ? x[3 * E[0].b + d] - x[3 * E[0].a + d] : x[3 * E[0].a + d] - x[3 * E[0].b + d];
+  fcm__vec3_cross(e, m, w);
+  const double lw = sqrt(fcm__vec3_dot(w, w));
+  if (!(lw > 0.0)) return;
+  for (int d = 0; d < 3; d++) {
+    walls[ss].n[d] = w[d] / lw;
+    walls[sr].n[d] = -walls[ss].n[d];
+  }
+  walls[ss].through = s_fwd ? 1 : 2; /* through vertex a, the edge's start or end */
+  walls[sr].through = r_fwd ? 1 : 2;
+}
+
 fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner,
-                                      fcm_index *ref)
+                                      fcm_index *ref, fcm__cut_wall *walls)
 {
   fcm_status st = FCM_OK;
   const fcm_index nt = fcm_surface_num_triangles(cut);
@@ -132,6 +166,7 @@ fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsi
   const fcm_index *tv = fcm_surface_triangles(cut);
   edge_key *E = NULL;
   memset(inner, 0, 3 * (size_t)nt);
+  memset(walls, 0, 3 * (size_t)nt * sizeof *walls);
   for (fcm_index t = 0; t < nt; t++)
     ref[t] = t;
   if (nt < 2) return FCM_OK;
@@ -166,8 +201,11 @@ fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsi
     const int s_ref = fcm__vec3_dot(cs, cs) >= fcm__vec3_dot(cr, cr);
     const double *nref = s_ref ? ns : nr, dref = s_ref ? ds : dr;
     const double *far = x + 3 * (s_ref ? fr : fs);
-    if (fabs(fcm__vec3_dot(nref, far) - dref) > 1e-12 * lmax) continue;
-    if (!(fcm__vec3_dot(cs, nref) * fcm__vec3_dot(cr, nref) < 0.0)) continue;
+    if (fabs(fcm__vec3_dot(nref, far) - dref) > 1e-12 * lmax ||
+        !(fcm__vec3_dot(cs, nref) * fcm__vec3_dot(cr, nref) < 0.0)) {
+      shared_wall(x, tv, E + i, ns, nr, walls);
+      continue;
+    }
     inner[E[i].slot] = inner[E[i + 1].slot] = 1;
     const fcm_index ra = tri_find(ref, s), rb = tri_find(ref, r);
     if (ra != rb) ref[FCM_MAX(ra, rb)] = FCM_MIN(ra, rb);

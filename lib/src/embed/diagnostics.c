@@ -128,7 +128,7 @@ fcm_status fcm__embed_cut_check(fcm_ctx *ctx, const fcm_surface *cut, const char
   for (fcm_index t = 0; t < nt; t++) {
     fcm__cut_tri probe;
     if (fcm__embed_cut_tri_setup(x + 3 * tv[3 * t], x + 3 * tv[3 * t + 1], x + 3 * tv[3 * t + 2], 0,
-                                 none, NULL, &probe))
+                                 none, NULL, NULL, &probe))
       return FCM_OK;
   }
   const double *a = x + 3 * tv[0], *b = x + 3 * tv[1], *c = x + 3 * tv[2];

@@ -182,6 +182,7 @@ typedef struct fcm__embed_counts {
   double sliver_volume;        /* summed volume of the dropped slivers */
   double moved_volume;         /* volume the rescaled rules of non-convex parts move */
   fcm_index degenerate;        /* cells whose cut splitting changed the parts' volume */
+  double split_change;         /* the largest such change, relative to its cell's volume */
   fcm_index surface_cells;     /* cut cells fitted on surface moments */
   fcm_index surface_fallbacks; /* of those, cells whose fit failed (volume path instead) */
   fcm_index kept;              /* cells a cut reaches whose pieces it leaves unchanged */
@@ -305,11 +306,22 @@ fcm_status fcm__embed_selected_area(fcm_ctx *ctx, const fcm_mesh *mesh, const fc
 fcm_status fcm__embed_cut_candidates(fcm_ctx *ctx, const fcm_aabb_tree *cut_tree,
                                      const fcm__embed_cell *cell, fcm__idbuf *buf);
 
+/* A wall that the two triangles of an edge share (fcm__embed_cut_inner_edges()): its unit
+ * normal, pointing out of the triangle that owns this edge slot (the other's is its negation,
+ * bit for bit), and the edge's vertex it passes through: 1 the edge's start (x[k]), 2 its end
+ * (x[k + 1]), 0 no shared wall (the triangle's own edge plane). */
+typedef struct fcm__cut_wall {
+  double n[3];
+  unsigned char through;
+} fcm__cut_wall;
+
 /* Prepare triangle (a, b, c), with the plane of the triangle ref (9 doubles; NULL: its
- * own) oriented as its own; 0 when it has no area (relative 1e-14 of its longest edge
- * squared): such a triangle separates nothing and is skipped. */
+ * own) oriented as its own, and the edge planes of walls (3, one per edge; NULL: all its own,
+ * through the edge perpendicular to the triangle); 0 when it has no area (relative 1e-14 of its
+ * longest edge squared): such a triangle separates nothing and is skipped. */
 int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
-                             const unsigned char inner[3], const double *ref, fcm__cut_tri *t);
+                             const unsigned char inner[3], const double *ref,
+                             const fcm__cut_wall *walls, fcm__cut_tri *t);
 
 /* For each edge of the cut surface's triangles (3 per triangle, edge k from vertex k to
  * k + 1), whether exactly one other triangle shares it and lies in the same plane (the
@@ -317,9 +329,14 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
  * plane) on the other side of the edge. ref[t]: the largest triangle of t's coplanar patch
  * (triangles joined through such edges); all of a patch take its plane, so that they
  * classify every point alike (a sliver's own normal can be off by far more than the
- * tolerances). */
+ * tolerances). walls (3 per triangle): an edge that exactly two triangles share, not inner,
+ * whose consistently oriented normals lie within 60 degrees of each other, gets one wall for
+ * both, through the edge along the mean of their normals: the two triangles' columns then meet
+ * on that wall (with each its own perpendicular edge plane, the columns of two nearly
+ * coplanar triangles overlap on one side of the surface and leave a gap on the other, thin
+ * wedges that the tolerances cannot resolve and that split a cell's parts many times over). */
 fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner,
-                                      fcm_index *ref);
+                                      fcm_index *ref, fcm__cut_wall *walls);
 
 /* The ints per face polygon in fcm__parts' and cell_out's fmeta. */
 #define FCM__EMBED_FMETA 5

@@ -167,9 +167,10 @@ static fcm__plane flip(const fcm__plane *pl)
   return q;
 }
 
-/* Split part i by triangle t into up to 8 parts (both sides of its plane, each side
- * inside or outside each edge plane); the first stays in slot i, the rest are appended.
- * A part strictly on one side of the plane or strictly outside an edge plane is left. */
+/* Split part i by triangle t into up to 5 parts (outside each edge plane in turn, then the
+ * rest, inside all three, on both sides of its plane); the first stays in slot i, the rest are
+ * appended. A part strictly on one side of the plane, or outside an edge plane up to the
+ * tolerance, is left. */
 fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *t,
                                  fcm__parts *P, size_t i)
 {
@@ -188,30 +189,33 @@ fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, cons
   for (int e = 0; e < 3; e++) {
     if (t->inner[e]) continue;
     plane_range(P->poly + i, &t->edge[e], &lo, &hi);
-    if (lo > tol) return FCM_OK;
+    if (lo >= -tol) return FCM_OK;
   }
   P->whole = 0;
   const double full = P->mat && fcm__embed_part_full(P, i) ? -1.0 : 0.0; /* the pieces' too */
-  fcm__poly *W = P->w; /* W[0]: the part; W[1]: one side; W[2]: outside an edge */
+  fcm__poly *W = P->w; /* W[0]: the part in the column; W[1]: one side; W[2]: outside an edge */
   poly_copy(&W[0], P->poly + i);
   size_t slot = i;
   int overflow = 0;
-  for (int side = 0; side < 2; side++) {
+  /* outside the triangle's column the plane is no cut: what lies there is left whole (split
+   * by the plane's extension, it would make thin slabs between it and a neighbouring
+   * triangle's plane, which the tolerance cannot resolve) */
+  for (int e = 0; e < 3 && W[0].nf > 0; e++) {
+    if (t->inner[e]) continue;
+    poly_copy(&W[2], &W[0]);
+    const fcm__plane out = flip(&t->edge[e]);
+    overflow |= fcm__geom_poly_clip(&W[2], &out, tol, &P->scratch);
+    overflow |= fcm__geom_poly_clip(&W[0], &t->edge[e], tol, &P->scratch);
+    if (W[2].nf > 0) {
+      FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, &W[2], P->tol[i], vmin, parent));
+      P->mvol[slot] = full;
+      slot = P->n;
+    }
+  }
+  for (int side = 0; side < 2 && W[0].nf > 0; side++) {
     poly_copy(&W[1], &W[0]);
     const fcm__plane h = side ? flip(&t->plane) : t->plane;
     overflow |= fcm__geom_poly_clip(&W[1], &h, tol, &P->scratch);
-    for (int e = 0; e < 3 && W[1].nf > 0; e++) {
-      if (t->inner[e]) continue;
-      poly_copy(&W[2], &W[1]);
-      const fcm__plane out = flip(&t->edge[e]);
-      overflow |= fcm__geom_poly_clip(&W[2], &out, tol, &P->scratch);
-      overflow |= fcm__geom_poly_clip(&W[1], &t->edge[e], tol, &P->scratch);
-      if (W[2].nf > 0) {
-        FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, &W[2], P->tol[i], vmin, parent));
-        P->mvol[slot] = full;
-        slot = P->n;
-      }
-    }
     if (W[1].nf > 0) {
       FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, &W[1], P->tol[i], vmin, parent));
       P->mvol[slot] = full;

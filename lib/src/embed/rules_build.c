@@ -401,6 +401,7 @@ void fcm__embed_gather_stats(fcm_cell_rules *R, const fcm_geometry *geom, const 
   S->sliver_volume = sums->counts.sliver_volume;
   S->moved_volume = sums->counts.moved_volume;
   S->num_degenerate = sums->counts.degenerate;
+  S->split_change = sums->counts.split_change;
   S->surface_triangles = sums->counts.surface_triangles;
   S->num_surface_cells = sums->counts.surface_cells;
   S->num_surface_fallbacks = sums->counts.surface_fallbacks;

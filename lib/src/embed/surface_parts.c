@@ -531,7 +531,7 @@ static fcm_status body_split(fcm_ctx *ctx, fcm__material *m, const fcm__embed_ce
     const fcm_index *tv = g->tris + 3 * ids[k];
     fcm__cut_tri t;
     if (!fcm__embed_cut_tri_setup(g->coords + 3 * tv[0], g->coords + 3 * tv[1],
-                                  g->coords + 3 * tv[2], 0, outer, NULL, &t))
+                                  g->coords + 3 * tv[2], 0, outer, NULL, NULL, &t))
       continue;
     double x[3 * FCM__POLY_MAX_VERTS], work[3 * FCM__POLY_MAX_VERTS];
     const size_t n0 = Q->n;
