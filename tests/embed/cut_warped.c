@@ -11,17 +11,19 @@
  *   volume the warp moves), and the pieces keep the body's volume to 1e-12.
  * One cell alone (fcm__embed_cell_pieces()), a unit cube crossed by 300 random warped sheets
  * (M = 2 .. 8 squares a side over 1.6 cells, 1 to 8 triangles a cell in a row, amp 1e-3 to
- * 1e-2 at a higher frequency, random offsets and slopes): where the split keeps the cell's
- * volume to 1e-12 (else it is degenerate, and the rules' build shifts the cut; fewer than a
- * quarter of the sheets), exactly two pieces of more than 1e-14 of the cell, each on one side
- * of the sheet (every part's centre farther than 3 amp from the smooth sheet on its piece's
- * side).
+ * 1e-2 at a higher frequency, random offsets and slopes; every second sheet with every second
+ * triangle's orientation reversed): where the split keeps the cell's volume to 1e-12 (else it
+ * is degenerate, and the rules' build shifts the cut; at most 1 in 20 of the sheets), exactly
+ * two pieces of more than 1e-14 of the cell, each on one side of the sheet (every part's centre
+ * farther than 3 amp from the smooth sheet on its piece's side). `embed_cut_warped study N`
+ * counts N sheets over a wider range (amp 1e-5 to 1e-2, 2 to 11 squares a side) without
+ * asserting (lib/docs/cutting.md).
  * The triangles' columns meet on one wall per shared edge, and a triangle splits by its plane
- * only what lies in its column; with each triangle's own perpendicular edge planes and its
- * plane extended outside its column, the cells held thin slabs between nearly coplanar planes
- * that the tolerance could not resolve, and the sheet left some cells whole (on the ball the
- * plane's extension does that alone; in the single cell, without the shared walls, 123 of 300
- * such sheets give other pieces). */
+ * only what lies in its column: with each triangle's own perpendicular edge planes, or its
+ * plane extended outside its column, cells hold thin slabs between nearly coplanar planes that
+ * the tolerance cannot resolve, and the sheet leaves some cells whole (the ball's cases need
+ * the column; the single cell's the shared walls too: without them, 89 of its 300 sheets give
+ * other pieces and 22 more are degenerate). */
 #include "cut_util.h"
 #include "embed/embed_impl.h"
 
@@ -117,7 +119,7 @@ static void run(const fcm_mesh *mesh, const fcm_geometry *g, const char *what)
            "pieces, piece volumes within %.2e of a cell\n",
            what, M, (long long)fcm_cell_rules_num_pieces(r),
            (long long)fcm_cell_rules_num_pieces(flat), (long long)S->num_degenerate, wrong, worst);
-    TEST_TRUE(S->num_degenerate == 0);
+    TEST_TRUE(S->num_degenerate == 0 && S->split_change <= 1e-12);
     TEST_TRUE(wrong == 0);
     TEST_TRUE(worst <= 5e-3);
     TEST_NEAR(total_volume(r), total_volume(r0), 1e-12, 0);
@@ -135,13 +137,13 @@ static double uniform(unsigned long long *state)
 }
 
 /* One random warped sheet over the unit cell: its pieces as the rules' build finds them. */
-static void one_cell(const fcm__embed_cell *cell, unsigned long long *state, int *wrong,
-                     int *degenerate)
+static void one_cell(const fcm__embed_cell *cell, int wide, int flip, unsigned long long *state,
+                     int *wrong, int *degenerate)
 {
-  const int M = 2 + (int)(7 * uniform(state));
-  const double amp = pow(10.0, -3.0 + uniform(state)), z0 = 0.2 + 0.6 * uniform(state),
-               sx = 0.3 * (uniform(state) - 0.5), sy = 0.3 * (uniform(state) - 0.5),
-               ph = uniform(state);
+  const int M = 2 + (int)((wide ? 10 : 7) * uniform(state));
+  const double amp = pow(10.0, wide ? -5.0 + 3.0 * uniform(state) : -3.0 + uniform(state)),
+               z0 = 0.2 + 0.6 * uniform(state), sx = 0.3 * (uniform(state) - 0.5),
+               sy = 0.3 * (uniform(state) - 0.5), ph = uniform(state);
   const fcm_index nv = (fcm_index)(M + 1) * (M + 1), nt = 2 * (fcm_index)M * M;
   double *x = malloc(3 * (size_t)nv * sizeof *x);
   fcm_index *tv = malloc(3 * (size_t)nt * sizeof *tv), k = 0;
@@ -164,7 +166,7 @@ static void one_cell(const fcm__embed_cell *cell, unsigned long long *state, int
     for (int i = 0; i < M; i++) {
       const fcm_index a = (fcm_index)j * (M + 1) + i, b = a + 1, c = a + M + 1, d = c + 1;
       tv[3 * k] = a, tv[3 * k + 1] = b, tv[3 * k + 2] = d, k++;
-      tv[3 * k] = a, tv[3 * k + 1] = d, tv[3 * k + 2] = c, k++;
+      tv[3 * k] = a, tv[3 * k + 1] = flip ? c : d, tv[3 * k + 2] = flip ? d : c, k++;
     }
   TEST_OK(ctx, fcm_surface_create(ctx, nv, x, nt, tv, &s));
   if (s) TEST_OK(ctx, fcm__embed_cut_inner_edges(ctx, s, inner, ref, walls));
@@ -235,8 +237,10 @@ static void one_cell(const fcm__embed_cell *cell, unsigned long long *state, int
   fcm_surface_destroy(&s);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+  /* "study N": N sheets of amplitude 1e-5 to 1e-2 and 2 to 11 squares a side, counted only */
+  const int study = argc > 2 && strcmp(argv[1], "study") == 0 ? atoi(argv[2]) : 0;
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
   const double lo[3] = {-1.1, -1.1, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c0[3] = {0, 0, 0};
   const fcm_index n[3] = {8, 8, 8};
@@ -245,8 +249,8 @@ int main(void)
   TEST_OK(ctx, fcm_mesh_create_box(ctx, FCM_ELEMENT_HEX8, lo, hi, n, &mesh));
   TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 1.0, 2, &gv));
   if (gv) surface_of(ctx, gv, &gs);
-  if (mesh && gv) run(mesh, gv, "tets");
-  if (mesh && gs) run(mesh, gs, "surface");
+  if (mesh && gv && !study) run(mesh, gv, "tets");
+  if (mesh && gs && !study) run(mesh, gs, "surface");
   fcm_geometry_destroy(&gs);
   fcm_geometry_destroy(&gv);
   fcm_mesh_destroy(&mesh);
@@ -259,13 +263,16 @@ int main(void)
     TEST_OK(ctx, fcm__embed_cell_setup(ctx, mesh, 0, 1e-10, &cell));
     unsigned long long state = 1;
     int wrong = 0, degenerate = 0;
-    for (int k = 0; k < 300; k++)
-      one_cell(&cell, &state, &wrong, &degenerate);
-    printf("one cell: %d of 300 warped sheets degenerate (the split changes the volume: the "
+    const int ns = study > 0 ? study : 300;
+    for (int k = 0; k < ns; k++)
+      one_cell(&cell, study > 0, k % 2, &state, &wrong, &degenerate);
+    printf("one cell: %d of %d warped sheets degenerate (the split changes the volume: the "
            "cut is shifted), %d of the others with other pieces\n",
-           degenerate, wrong);
-    TEST_TRUE(wrong == 0);
-    TEST_TRUE(degenerate < 300 / 4);
+           degenerate, ns, wrong);
+    if (!study) {
+      TEST_TRUE(wrong == 0);
+      TEST_TRUE(degenerate <= ns / 20);
+    }
   }
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);

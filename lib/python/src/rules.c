@@ -46,6 +46,7 @@ static const fcmpy_option stats_table[] = {
     {"num_degenerate", 'n', 1, RS(num_degenerate)},
     {"cut_shift", 'd', 3, RS(cut_shift)},
     {"cut_attempts", 'i', 1, RS(cut_attempts)},
+    {"split_change", 'd', 1, RS(split_change)},
     {"num_tets", 'n', 1, RS(num_tets)},
     {"num_slivers", 'n', 1, RS(num_slivers)},
     {"sliver_volume", 'd', 1, RS(sliver_volume)},

@@ -207,7 +207,8 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
     sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
-    sums->counts.split_change = fmax(sums->counts.split_change, P->split_error / cell->volume);
+    const double change = P->split_error / cell->volume; /* NaN kept: undetermined */
+    if (isnan(change) || change > sums->counts.split_change) sums->counts.split_change = change;
   }
   FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
   if (B->prev) {
@@ -368,9 +369,10 @@ static fcm_status surface_rules(const build *B, const fcm__embed_cell *cell, fcm
     FCM_TRY(ctx, fcm__embed_cell_tets(ctx, B->geom, B->tree, cell, B->o->clip_rtol,
                                       B->o->sliver_rtol, ws, &sums->counts, &vol));
   } else {
+    double mvol = o->volume; /* the surface moments' */
     if (!ws->parts) FCM_ALLOC(ctx, 1, ws->parts);
     FCM_TRY(ctx, fcm__embed_cell_parts(ctx, B->geom, B->tree, cell, B->o->clip_rtol,
-                                       B->o->sliver_rtol, ws, ws->parts, NULL, NULL));
+                                       B->o->sliver_rtol, ws, ws->parts, &mvol, NULL));
     ws->num_tets = 0;
     if (ws->parts->n > 0)
       FCM_TRY(ctx, fcm__embed_piece_body_tets(ctx, cell, ws->parts, 0, ws, &vol));
@@ -641,7 +643,8 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
       sums->counts.sliver_volume += mine.counts.sliver_volume;
       sums->counts.moved_volume += mine.counts.moved_volume;
       sums->counts.degenerate += mine.counts.degenerate;
-      sums->counts.split_change = fmax(sums->counts.split_change, mine.counts.split_change);
+      if (isnan(mine.counts.split_change) || mine.counts.split_change > sums->counts.split_change)
+        sums->counts.split_change = mine.counts.split_change;
       sums->counts.surface_cells += mine.counts.surface_cells;
       sums->counts.surface_fallbacks += mine.counts.surface_fallbacks;
       sums->counts.kept += mine.counts.kept;

@@ -136,6 +136,19 @@ static void shared_wall(const double *x, const fcm_index *tv, const edge_key *E,
                         const double *nr, fcm__cut_wall *walls)
 {
   const fcm_index ss = E[0].slot, sr = E[1].slot;
+  /* both kept by fcm__embed_cut_tri_setup() (a sliver's normal would tilt the wall) */
+  for (int k = 0; k < 2; k++) {
+    const fcm_index t = E[k].slot / 3;
+    double l2 = 0.0;
+    for (int i = 0; i < 3; i++) {
+      const double *p = x + 3 * tv[3 * t + i], *q = x + 3 * tv[3 * t + (i + 1) % 3];
+      double d2 = 0.0;
+      for (int d = 0; d < 3; d++)
+        d2 += (q[d] - p[d]) * (q[d] - p[d]);
+      l2 = fmax(l2, d2);
+    }
+    if (!(tri_area2(x, tv, t) > 1e-14 * l2)) return;
+  }
   /* edge k of a triangle runs from its vertex k to k + 1: consistent orientations run the
    * shared edge in opposite directions */
   const int s_fwd = tv[ss] == E[0].a, r_fwd = tv[sr] == E[1].a;
