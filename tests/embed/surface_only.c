@@ -74,6 +74,20 @@ static void check_moments(const fcm_cell_rules *r, const fcm_mesh *mesh, const f
   }
 }
 
+/* A geometry of nc tets (nv corners x) and its boundary as a geometry without a volume mesh. */
+static void tets_and_surface(fcm_index nv, const double *x, fcm_index nc, const fcm_index *tc,
+                             const fcm_surface_mesh_options *mo, fcm_geometry **tets,
+                             fcm_geometry **surf)
+{
+  fcm_surface *s = NULL;
+  TEST_OK(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, nv, x, nc, tc, tets));
+  if (*tets)
+    TEST_OK(ctx, fcm_surface_create(ctx, nv, x, fcm_geometry_num_boundary_triangles(*tets),
+                                    fcm_geometry_boundary_triangles(*tets), &s));
+  if (s) TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, s, mo, surf));
+  fcm_surface_destroy(&s);
+}
+
 /* The rules of a surface geometry against its tets (check_moments()), every cut cell fitted on
  * surface moments; fell_back: some of them are expected to take the volume path (else none). */
 static void moments(const fcm_mesh *mesh, const fcm_geometry *surf, const fcm_geometry *tets,
@@ -226,19 +240,12 @@ int main(void)
     const fcm_index tn[3] = {5, 5, 5};
     const fcm_element_type tt[2] = {FCM_ELEMENT_HEX8, FCM_ELEMENT_TET4};
     fcm_geometry *tet = NULL, *tsurf = NULL;
-    fcm_surface *ts = NULL;
-    TEST_OK(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, 4, tx, 1, tc, &tet));
-    if (tet) {
-      TEST_OK(ctx, fcm_surface_create(ctx, 4, tx, fcm_geometry_num_boundary_triangles(tet),
-                                      fcm_geometry_boundary_triangles(tet), &ts));
-      TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, ts, &mo, &tsurf));
-    }
+    tets_and_surface(4, tx, 1, tc, &mo, &tet, &tsurf);
     for (int t = 0; t < 2 && tsurf; t++) {
       TEST_OK(ctx, fcm_mesh_create_box(ctx, tt[t], tlo, thi, tn, &mesh));
       if (mesh) moments(mesh, tsurf, tet, 0, 0.0);
       fcm_mesh_destroy(&mesh);
     }
-    fcm_surface_destroy(&ts);
     fcm_geometry_destroy(&tsurf);
     fcm_geometry_destroy(&tet);
   }
@@ -257,20 +264,13 @@ int main(void)
     const fcm_index tc[24] = {0, 1, 3, 7, 0, 3, 2, 7, 0, 2, 6, 7,
                               0, 6, 4, 7, 0, 4, 5, 7, 0, 5, 1, 7};
     fcm_geometry *slab = NULL, *ssurf = NULL;
-    fcm_surface *ss = NULL;
-    TEST_OK(ctx, fcm_geometry_create(ctx, FCM_ELEMENT_TET4, 8, x, 6, tc, &slab));
-    if (slab) {
-      TEST_OK(ctx, fcm_surface_create(ctx, 8, x, fcm_geometry_num_boundary_triangles(slab),
-                                      fcm_geometry_boundary_triangles(slab), &ss));
-      TEST_OK(ctx, fcm_geometry_create_from_surface(ctx, ss, &mo, &ssurf));
-    }
+    tets_and_surface(8, x, 6, tc, &mo, &slab, &ssurf);
     for (int t3 = 0; t3 < 3 && ssurf; t3++) {
       TEST_OK(ctx, fcm_mesh_create_box(ctx, types[t3], lo, hi, n, &mesh));
       const double box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
       if (mesh) moments(mesh, ssurf, slab, 1, 1e-14 * box / (double)fcm_mesh_num_cells(mesh));
       fcm_mesh_destroy(&mesh);
     }
-    fcm_surface_destroy(&ss);
     fcm_geometry_destroy(&ssurf);
     fcm_geometry_destroy(&slab);
   }
