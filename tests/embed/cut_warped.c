@@ -22,8 +22,7 @@
  * only what lies in its column: with each triangle's own perpendicular edge planes, or its
  * plane extended outside its column, cells hold thin slabs between nearly coplanar planes that
  * the tolerance cannot resolve, and the sheet leaves some cells whole (the ball's cases need
- * the column; the single cell's the shared walls too: without them, 89 of its 300 sheets give
- * other pieces and 22 more are degenerate). */
+ * the column; the single cell's the shared walls too). */
 #include "cut_util.h"
 #include "embed/embed_impl.h"
 

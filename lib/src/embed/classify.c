@@ -186,6 +186,12 @@ cleanup:
   return st;
 }
 
+/* *m = max(*m, v), a NaN kept (undetermined). */
+static void keep_largest(double *m, double v)
+{
+  if (isnan(v) || v > *m) *m = v;
+}
+
 /* The convex parts and material pieces of a cell that cuts reach (or that lies next to
  * such a cell): parts, split, grouped; empty pieces (all slivers) are removed. On return
  * P->piece numbers the pieces with volume, -1 for parts of removed ones; vol[i] is the
@@ -207,8 +213,7 @@ static fcm_status cell_pieces(const build *B, const fcm__embed_cell *cell, fcm__
   if (P->tcand.n > 0) {
     FCM_TRY(ctx, fcm__embed_cell_pieces(ctx, cell, B->cut_tris, B->first_new, P));
     sums->counts.degenerate += !(P->split_error <= DEGENERATE_RTOL * cell->volume);
-    const double change = P->split_error / cell->volume; /* NaN kept: undetermined */
-    if (isnan(change) || change > sums->counts.split_change) sums->counts.split_change = change;
+    keep_largest(&sums->counts.split_change, P->split_error / cell->volume);
   }
   FCM_ALLOC(ctx, (size_t)P->num_pieces + 1, *vol);
   if (B->prev) {
@@ -643,8 +648,7 @@ fcm_status fcm__embed_run_cells(const build *B, fcm_cell_rules *R, int nthreads,
       sums->counts.sliver_volume += mine.counts.sliver_volume;
       sums->counts.moved_volume += mine.counts.moved_volume;
       sums->counts.degenerate += mine.counts.degenerate;
-      if (isnan(mine.counts.split_change) || mine.counts.split_change > sums->counts.split_change)
-        sums->counts.split_change = mine.counts.split_change;
+      keep_largest(&sums->counts.split_change, mine.counts.split_change);
       sums->counts.surface_cells += mine.counts.surface_cells;
       sums->counts.surface_fallbacks += mine.counts.surface_fallbacks;
       sums->counts.kept += mine.counts.kept;

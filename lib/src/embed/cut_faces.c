@@ -21,22 +21,32 @@ fcm_status fcm__embed_cut_candidates(fcm_ctx *ctx, const fcm_aabb_tree *cut_tree
   return fcm__geom_tree_query(ctx, cut_tree, lo, hi, buf);
 }
 
-int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
-                             const unsigned char inner[3], const double *ref,
-                             const fcm__cut_wall *walls, fcm__cut_tri *t)
+/* The longest edge of triangle (a, b, c), squared: a triangle whose |(b - a) x (c - a)| is
+ * not above 1e-14 of it has no area for the cuts. */
+static double longest_edge2(const double *a, const double *b, const double *c)
 {
-  memcpy(t->inner, inner, sizeof t->inner);
-  double e0[3], e1[3], n[3], l2 = 0.0;
-  memcpy(t->x[0], a, sizeof t->x[0]);
-  memcpy(t->x[1], b, sizeof t->x[1]);
-  memcpy(t->x[2], c, sizeof t->x[2]);
+  const double *v[3] = {a, b, c};
+  double l2 = 0.0;
   for (int k = 0; k < 3; k++) {
-    const double *p = t->x[k], *q = t->x[(k + 1) % 3];
+    const double *p = v[k], *q = v[(k + 1) % 3];
     double d2 = 0.0;
     for (int d = 0; d < 3; d++)
       d2 += (q[d] - p[d]) * (q[d] - p[d]);
     l2 = fmax(l2, d2);
   }
+  return l2;
+}
+
+int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double c[3], int cut,
+                             const unsigned char inner[3], const double *ref,
+                             const fcm__cut_wall *walls, fcm__cut_tri *t)
+{
+  memcpy(t->inner, inner, sizeof t->inner);
+  double e0[3], e1[3], n[3];
+  const double l2 = longest_edge2(a, b, c);
+  memcpy(t->x[0], a, sizeof t->x[0]);
+  memcpy(t->x[1], b, sizeof t->x[1]);
+  memcpy(t->x[2], c, sizeof t->x[2]);
   for (int d = 0; d < 3; d++) {
     e0[d] = b[d] - a[d];
     e1[d] = c[d] - a[d];
@@ -138,25 +148,18 @@ static void shared_wall(const double *x, const fcm_index *tv, const edge_key *E,
   const fcm_index ss = E[0].slot, sr = E[1].slot;
   /* both kept by fcm__embed_cut_tri_setup() (a sliver's normal would tilt the wall) */
   for (int k = 0; k < 2; k++) {
-    const fcm_index t = E[k].slot / 3;
-    double l2 = 0.0;
-    for (int i = 0; i < 3; i++) {
-      const double *p = x + 3 * tv[3 * t + i], *q = x + 3 * tv[3 * t + (i + 1) % 3];
-      double d2 = 0.0;
-      for (int d = 0; d < 3; d++)
-        d2 += (q[d] - p[d]) * (q[d] - p[d]);
-      l2 = fmax(l2, d2);
-    }
-    if (!(tri_area2(x, tv, t) > 1e-14 * l2)) return;
+    const fcm_index *v = tv + 3 * (E[k].slot / 3);
+    const double l2 = longest_edge2(x + 3 * v[0], x + 3 * v[1], x + 3 * v[2]);
+    if (!(tri_area2(x, tv, E[k].slot / 3) > 1e-14 * l2)) return;
   }
   /* edge k of a triangle runs from its vertex k to k + 1: consistent orientations run the
    * shared edge in opposite directions */
   const int s_fwd = tv[ss] == E[0].a, r_fwd = tv[sr] == E[1].a;
   const double sg = s_fwd != r_fwd ? 1.0 : -1.0;
   double m[3], e[3], w[3];
+  if (!(fcm__vec3_dot(ns, nr) * sg >= 0.5)) return;
   for (int d = 0; d < 3; d++)
     m[d] = ns[d] + sg * nr[d];
-  if (!(fcm__vec3_dot(ns, nr) * sg >= 0.5)) return;
   for (int d = 0; d < 3; d++) /* along s's edge: e x n points out of s */
     e[d] = s_fwd ? x[3 * E[0].b + d] - x[3 * E[0].a + d] : x[3 * E[0].a + d] - x[3 * E[0].b + d];
   fcm__vec3_cross(e, m, w);
