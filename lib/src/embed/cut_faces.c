@@ -42,6 +42,8 @@ int fcm__embed_cut_tri_setup(const double a[3], const double b[3], const double 
                              const fcm__cut_wall *walls, fcm__cut_tri *t)
 {
   memcpy(t->inner, inner, sizeof t->inner);
+  for (int k = 0; k < 3; k++)
+    t->owns[k] = walls && walls[k].through ? walls[k].owns : 0;
   double e0[3], e1[3], n[3];
   const double l2 = longest_edge2(a, b, c);
   memcpy(t->x[0], a, sizeof t->x[0]);
@@ -171,6 +173,7 @@ static void shared_wall(const double *x, const fcm_index *tv, const edge_key *E,
   }
   walls[ss].through = s_fwd ? 1 : 2; /* through vertex a, the edge's start or end */
   walls[sr].through = r_fwd ? 1 : 2;
+  walls[ss].owns = 1, walls[sr].owns = 0;
 }
 
 fcm_status fcm__embed_cut_inner_edges(fcm_ctx *ctx, const fcm_surface *cut, unsigned char *inner,

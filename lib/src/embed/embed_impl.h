@@ -23,6 +23,9 @@ typedef struct fcm__cut_tri {
   /* edge k (x[k] -> x[k+1]) is shared with a coplanar triangle of the same cut: the two
    * cover the plane on both sides of it, so it splits nothing and bounds nothing */
   unsigned char inner[3];
+  /* edge k's plane is a wall shared with the edge's other triangle, and a part lying flat on
+   * it (within the tolerance everywhere) belongs to this triangle's column, not the other's */
+  unsigned char owns[3];
 } fcm__cut_tri;
 
 struct fcm_cell_rules {
@@ -309,10 +312,12 @@ fcm_status fcm__embed_cut_candidates(fcm_ctx *ctx, const fcm_aabb_tree *cut_tree
 /* A wall that the two triangles of an edge share (fcm__embed_cut_inner_edges()): its unit
  * normal, pointing out of the triangle that owns this edge slot (the other's is its negation,
  * bit for bit), and the edge's vertex it passes through: 1 the edge's start (x[k]), 2 its end
- * (x[k + 1]), 0 no shared wall (the triangle's own edge plane). */
+ * (x[k + 1]), 0 no shared wall (the triangle's own edge plane); owns: 1 in exactly one of the
+ * two triangles' slots, whose column takes a part lying flat on the wall (that the tolerance
+ * cannot place on either side: left to both, it would join the two sides of the surface). */
 typedef struct fcm__cut_wall {
   double n[3];
-  unsigned char through;
+  unsigned char through, owns;
 } fcm__cut_wall;
 
 /* Prepare triangle (a, b, c), with the plane of the triangle ref (9 doubles; NULL: its

@@ -34,6 +34,8 @@
  * matching tolerance of a cut triangle: clipping one face by the other's edges places new
  * vertices on segments between points within the tolerance, up to rounding. */
 #define ON_CUT_FACTOR 2.0
+/* A shared face is wider than this many times the matching tolerance (overlap_shared()). */
+#define WIDE_FACTOR 4.0
 
 void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P)
 {
@@ -189,7 +191,7 @@ fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, cons
   for (int e = 0; e < 3; e++) {
     if (t->inner[e]) continue;
     plane_range(P->poly + i, &t->edge[e], &lo, &hi);
-    if (lo >= -tol) return FCM_OK;
+    if (lo >= -tol && !(t->owns[e] && hi <= tol)) return FCM_OK;
   }
   P->whole = 0;
   const double full = P->mat && fcm__embed_part_full(P, i) ? -1.0 : 0.0; /* the pieces' too */
@@ -202,20 +204,31 @@ fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, cons
    * triangle's plane, which the tolerance cannot resolve) */
   for (int e = 0; e < 3 && W[0].nf > 0; e++) {
     if (t->inner[e]) continue;
+    /* a part flat on a plane is kept by both clips: it goes whole to one side, inside the
+     * column on the wall this triangle owns, else outside */
+    plane_range(&W[0], &t->edge[e], &lo, &hi);
+    const int flat = lo >= -tol && hi <= tol;
+    if (flat && t->owns[e]) continue;
     poly_copy(&W[2], &W[0]);
-    const fcm__plane out = flip(&t->edge[e]);
-    overflow |= fcm__geom_poly_clip(&W[2], &out, tol, &P->scratch);
-    overflow |= fcm__geom_poly_clip(&W[0], &t->edge[e], tol, &P->scratch);
+    if (flat) {
+      W[0].nv = W[0].nf = 0;
+    } else {
+      const fcm__plane out = flip(&t->edge[e]);
+      overflow |= fcm__geom_poly_clip(&W[2], &out, tol, &P->scratch);
+      overflow |= fcm__geom_poly_clip(&W[0], &t->edge[e], tol, &P->scratch);
+    }
     if (W[2].nf > 0) {
       FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, &W[2], P->tol[i], vmin, parent));
       P->mvol[slot] = full;
       slot = P->n;
     }
   }
-  for (int side = 0; side < 2 && W[0].nf > 0; side++) {
+  plane_range(&W[0], &t->plane, &lo, &hi);
+  const int flat = lo >= -tol && hi <= tol; /* one part, the flat one the links treat as such */
+  for (int side = 0; side < 2 - flat && W[0].nf > 0; side++) {
     poly_copy(&W[1], &W[0]);
     const fcm__plane h = side ? flip(&t->plane) : t->plane;
-    overflow |= fcm__geom_poly_clip(&W[1], &h, tol, &P->scratch);
+    if (!flat) overflow |= fcm__geom_poly_clip(&W[1], &h, tol, &P->scratch);
     if (W[1].nf > 0) {
       FCM_TRY(ctx, fcm__embed_parts_put(ctx, P, slot, &W[1], P->tol[i], vmin, parent));
       P->mvol[slot] = full;
@@ -297,6 +310,25 @@ static double polygon_area(const double *x, int m)
     n[2] += (p[0] - q[0]) * (p[1] + q[1]);
   }
   return 0.5 * sqrt(fcm__vec3_dot(n, n));
+}
+
+/* Whether the overlap x (m vertices) of two faces is one they share: more than atol of area,
+ * and wider than the band the tolerance alone makes. Faces within tol of each other's planes
+ * overlap up to tol beyond the edges of each, so a sliver face of no width overlaps a face
+ * across it in a band up to 2 tol wide; and a nearly zero edge of a sliver has an edge plane
+ * that can point anywhere, so the band can run far past the sliver's end (across a cut surface
+ * between parts on its two sides). The polygon's 2 area / perimeter (a strip's width) must
+ * exceed WIDE_FACTOR x tol. */
+static int overlap_shared(const double *x, int m, double atol, double tol)
+{
+  const double area = polygon_area(x, m);
+  double perimeter = 0.0;
+  for (int k = 0; k < m; k++) {
+    const double *p = x + 3 * k, *q = x + 3 * ((k + 1) % m);
+    const double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    perimeter += sqrt(fcm__vec3_dot(e, e));
+  }
+  return area > atol && 2.0 * area > WIDE_FACTOR * tol * perimeter;
 }
 
 /* The plane of edge p, q of a face with normal nrm, outward (zero normal: a point edge). */
@@ -413,7 +445,8 @@ int fcm__embed_linked(const double *a, int na, const double *va, int nva, const 
 {
   double x[3 * FCM__POLY_MAX_VERTS];
   int m = 0;
-  if (fcm__embed_overlap(a, na, b, nb, nb_normal, tol, x, &m) <= atol) return 0;
+  fcm__embed_overlap(a, na, b, nb, nb_normal, tol, x, &m);
+  if (m < 3 || !overlap_shared(x, m, atol, tol)) return 0;
   return overlap_linked(x, m, va, nva, vb, nvb, tol, tris, ids, n);
 }
 
@@ -672,7 +705,7 @@ static int faces_linked(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cu
   for (int k = 0; k < nb && m >= 3; k++)
     if (!zero_plane(ep + k))
       m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, ep + k, mtol, 1, work);
-  if (m < 3 || polygon_area(x, m) <= atol) return 0;
+  if (m < 3 || !overlap_shared(x, m, atol, mtol)) return 0;
   const fcm__poly *pa = P->poly + i, *pb = P->poly + j;
   return overlap_linked(x, m, pa->x[0], pa->nv, pb->x[0], pb->nv, mtol, tris, P->tcand.ids, ntri) &&
          (!P->mat || fcm__embed_part_full(P, (size_t)i) || fcm__embed_part_full(P, (size_t)j) ||
