@@ -139,9 +139,55 @@ static double uniform(unsigned long long *state)
   return (double)(*state >> 11) / 9007199254740992.0;
 }
 
-/* One random warped sheet over the unit cell: its pieces as the rules' build finds them. */
+/* The unit cube as the body on one Hex8 cell, and its rules: the cuts of one_cell() through
+ * fcm_cell_rules_create_cut(). */
+typedef struct unit_body {
+  const fcm_mesh *mesh;
+  fcm_geometry *box;
+  fcm_cell_rules *rules;
+  int accepted, wrong; /* cuts taken in the attempt of least change; cuts with other pieces */
+} unit_body;
+
+/* The cut s through the unit body: it goes through (the split's volume change is within the
+ * tolerance's layer, 1e-9 of the cell, if no shift resolves it), into two pieces, each with its
+ * centre (from its rule's first moments) on one side of the sheet, farther than 3 amp from it
+ * (height h). */
+static void unit_cut(unit_body *U, const fcm_surface *s, double amp, double (*h)(const double *))
+{
+  fcm_cell_rules *r = NULL;
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, U->mesh, U->box, U->rules, s, &r));
+  if (!r) return;
+  const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(r);
+  U->accepted += S->num_degenerate > 0;
+  TEST_TRUE(S->split_change <= 1e-9);
+  const fcm_index np = fcm_cell_rules_num_pieces(r);
+  int side = 0, ok = np == 2;
+  for (fcm_index p = 0; p < np && ok; p++) {
+    double mom[4], c[3];
+    piece_monomials(ctx, r, p, FCM_RULE_STIFFNESS, 1, mom);
+    for (int d = 0; d < 3; d++) /* the rules' points lie in the reference cell [-1, 1]^3 */
+      c[d] = 0.5 * (mom[3 - d] / mom[0] + 1.0);
+    const double hc = h(c);
+    ok = mom[0] > 1e-14 && fabs(hc) > 3.0 * amp && (hc > 0.0 ? 1 : 2) != side;
+    side = hc > 0.0 ? 1 : 2;
+  }
+  if (!ok) printf("unit body: a cut gives %lld pieces, not one on each side\n", (long long)np);
+  U->wrong += !ok;
+  fcm_cell_rules_destroy(&r);
+}
+
+/* The sheet of one_cell() (its parameters in sheet_p) at point x: the height above it. */
+static double sheet_p[5];
+static double sheet_height(const double *x)
+{
+  return x[2] - (sheet_p[0] + sheet_p[1] * x[0] + sheet_p[2] * x[1] +
+                 sheet_p[3] * sin(7.3 * x[0] + sheet_p[4]) * sin(6.1 * x[1] + 0.4));
+}
+
+/* One random warped sheet over the unit cell: its pieces as the rules' build finds them (and,
+ * with U, the cut of the unit body). */
 static void one_cell(const fcm__embed_cell *cell, int wide, int flip, unsigned long long *state,
-                     int *wrong, int *degenerate)
+                     int *wrong, int *degenerate, unit_body *U)
 {
   const int M = 2 + (int)((wide ? 10 : 7) * uniform(state));
   const double amp = pow(10.0, wide ? -5.0 + 3.0 * uniform(state) : -3.0 + uniform(state)),
@@ -173,6 +219,10 @@ static void one_cell(const fcm__embed_cell *cell, int wide, int flip, unsigned l
     }
   TEST_OK(ctx, fcm_surface_create(ctx, nv, x, nt, tv, &s));
   if (s) TEST_OK(ctx, fcm__embed_cut_inner_edges(ctx, s, inner, ref, walls));
+  if (s && U) {
+    sheet_p[0] = z0, sheet_p[1] = sx, sheet_p[2] = sy, sheet_p[3] = amp, sheet_p[4] = ph;
+    unit_cut(U, s, amp, sheet_height);
+  }
   fcm__geom_poly_from_cell(FCM_ELEMENT_HEX8, cell->X, q);
   TEST_OK(ctx, fcm__embed_parts_put(ctx, P, 0, q, cell->tol, 0.0, 0));
   P->tcand.ids = malloc((size_t)nt * sizeof *P->tcand.ids);
@@ -326,20 +376,33 @@ int main(int argc, char **argv)
   if (mesh) {
     TEST_OK(ctx, fcm__embed_cell_setup(ctx, mesh, 0, 1e-10, &cell));
     if (!study) flat_on_wall(&cell);
+    unit_body U = {mesh, NULL, NULL, 0, 0};
+    const fcm_index n1[3] = {1, 1, 1};
+    fcm_cell_rules_options o = fcm_cell_rules_options_default();
+    o.min_fraction = 0.0;
+    TEST_OK(ctx, fcm_geometry_create_box(ctx, ulo, uhi, n1, &U.box));
+    if (U.box) TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, U.box, &o, &U.rules));
     for (int wide = study > 0; wide < 2; wide++) {
       unsigned long long state = 1;
       int wrong = 0, degenerate = 0;
       const int ns = study > 0 ? study : wide ? 500 : 300;
+      U.accepted = U.wrong = 0;
       for (int k = 0; k < ns; k++)
-        one_cell(&cell, wide, k % 2, &state, &wrong, &degenerate);
+        one_cell(&cell, wide, k % 2, &state, &wrong, &degenerate,
+                 U.rules && wide && k % 4 < 2 ? &U : NULL);
       printf("one cell%s: %d of %d warped sheets degenerate (the split changes the volume: the "
-             "cut is shifted), %d of the others with other pieces\n",
-             wide ? ", wide range" : "", degenerate, ns, wrong);
+             "cut is shifted), %d of the others with other pieces; cut through the unit body: "
+             "%d taken within the tolerance's layer (no shift resolved them), %d with other "
+             "pieces\n",
+             wide ? ", wide range" : "", degenerate, ns, wrong, U.accepted, U.wrong);
       if (!study) {
-        TEST_TRUE(wrong == 0);
+        TEST_TRUE(wrong == 0 && U.wrong == 0);
         TEST_TRUE(degenerate <= (wide ? ns / 10 : ns / 20));
+        TEST_TRUE(!wide || U.accepted > 0); /* the path taken when no shift resolves a cell */
       }
     }
+    fcm_cell_rules_destroy(&U.rules);
+    fcm_geometry_destroy(&U.box);
   }
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);

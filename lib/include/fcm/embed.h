@@ -219,8 +219,10 @@ typedef struct fcm_cell_rules_stats {
                                       class, fraction, pieces and rules are copied bit for bit,
                                       their cut faces made again */
   fcm_index num_degenerate;      /**< cells whose splitting by the cuts changed their parts'
-                                      volume (0 after a successful fcm_cell_rules_create_cut():
-                                      it shifts the cut until there are none) */
+                                      volume by more than 1e-12 of the cell's (after a
+                                      successful fcm_cell_rules_create_cut() 0, unless no shift
+                                      resolved them and each change is within the tolerance's
+                                      layer, 1e-9: split_change) */
   double cut_shift[3];           /**< the translation fcm_cell_rules_create_cut() applied to the
                                       new cut to resolve degenerate cells; 0 when none was needed */
   int cut_attempts;              /**< times it applied the cut (1: no shift) */
@@ -271,7 +273,8 @@ typedef struct fcm_cell_rules_stats {
                             when surface rules are built (surface_strength >= 0), else 0 */
   double split_change; /**< the largest change of a cell's parts' volume by the cuts'
                             splitting, relative to the cell's volume (rounding, about 1e-15;
-                            above 1e-12 in the cells num_degenerate counts) */
+                            above 1e-12 in the cells num_degenerate counts; at most 1e-9 after
+                            a successful fcm_cell_rules_create_cut()) */
 } fcm_cell_rules_stats;
 
 /** Per-cell quadrature of an embedded geometry in a background mesh (opaque). */
@@ -375,7 +378,10 @@ FCM_API fcm_status fcm_cell_rules_get_surface(const fcm_cell_rules *rules, fcm_i
  * cannot resolve a cell (near-coincident vertices classified differently: splitting would
  * change the cell's volume, stats.num_degenerate), the whole cut is shifted by a small
  * deterministic translation (1e-7, then 1e-6, 1e-5 of the mean cell size; stats.cut_shift,
- * stats.cut_attempts) and applied again, so no volume is ever lost or doubled.
+ * stats.cut_attempts) and applied again. If no shift resolves it, the attempt of least change
+ * is taken when every cell's change is at most 1e-9 of its volume (the layer the tolerance
+ * leaves: a vertex taken as on a plane lies up to 1e-9 of the cell size off it; the pieces are
+ * as the tolerance places them, stats.num_degenerate > 0), else the cut fails.
  * @param[in] mesh, geom the mesh and geometry `prev` was built on; @param[in] cut copied
  * On an octree mesh pieces are also linked across faces between cells of different levels,
  * where a piece's part of the finer face overlaps a coarser piece's part of the coarser face.

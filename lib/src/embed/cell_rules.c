@@ -232,7 +232,7 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
                                            const fcm_surface *cut, int keep, fcm_cell_rules **rules)
 {
   fcm_status st = FCM_OK;
-  fcm_cell_rules *R = NULL;
+  fcm_cell_rules *R = NULL, *least = NULL;
   unsigned char *inner = NULL;
   fcm_index *ref = NULL;
   fcm__cut_wall *walls = NULL;
@@ -261,13 +261,14 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
   /* A cut that meets the parts of some cell in a way the tolerances cannot resolve (the
    * splitting changes their volume) is shifted by a small deterministic translation and
    * applied again: 1e-7, 1e-6, then 1e-5 of the mean cell size, along a fixed direction
-   * with no rational relation to the axes. */
+   * with no rational relation to the axes. If none resolves it, the attempt whose largest
+   * volume change is least is taken when that change is the tolerance's own (kept, not made
+   * again). */
   const double h = mean_cell_size(mesh);
   static const double dir[3] = {0.4636476090008061, 0.5880026035475675, 0.6628738660715610};
   static const double shift[CUT_ATTEMPTS] = {0.0, 1e-7, 1e-6, 1e-5};
   fcm_index degenerate = 0;
   for (int attempt = 0; attempt < CUT_ATTEMPTS; attempt++) {
-    fcm_cell_rules_destroy(&R);
     FCM_TRY(ctx, fcm__embed_rules_alloc(ctx, mesh, &prev->opts, &R));
     FCM_ALLOC(ctx, (size_t)(prev->num_cut_tris + nt), R->cut_tris);
     if (prev->num_cut_tris)
@@ -299,17 +300,33 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
     degenerate = R->stats.num_degenerate;
     R->stats.cut_attempts = attempt + 1;
     if (degenerate == 0) break;
+    const double change = R->stats.split_change; /* kept: the attempt of least change */
+    if (!least || isnan(least->stats.split_change) || change < least->stats.split_change) {
+      fcm_cell_rules_destroy(&least);
+      least = R;
+      R = NULL;
+    } else {
+      fcm_cell_rules_destroy(&R);
+    }
+  }
+  if (degenerate > 0) { /* none resolved: the attempt of least change, if it is the tolerance's */
+    R = least;
+    least = NULL;
+    R->stats.cut_attempts = CUT_ATTEMPTS;
+    degenerate = R->stats.num_degenerate;
   }
   if (prev->masked) {
     R->masked = 1;
     FCM_ALLOC(ctx, (size_t)prev->num_cells + 1, R->own);
     memcpy(R->own, prev->own, (size_t)prev->num_cells);
   }
-  FCM_CHECK(degenerate == 0, ctx, FCM_ERR_GEOMETRY,
+  FCM_CHECK(degenerate == 0 || R->stats.split_change <= DEGENERATE_ACCEPT_RTOL, ctx,
+            FCM_ERR_GEOMETRY,
             "embed cut: the cut meets %lld cell(s) in a degenerate way that shifts of up to %g "
             "(1e-5 of the mean cell size %g) did not resolve: splitting them changes their "
-            "volume (by up to %.3g of a cell's); move the cut",
-            (long long)degenerate, shift[CUT_ATTEMPTS - 1] * h, h, R->stats.split_change);
+            "volume (by up to %.3g of a cell's, more than the tolerance's %g); move the cut",
+            (long long)degenerate, shift[CUT_ATTEMPTS - 1] * h, h, R->stats.split_change,
+            DEGENERATE_ACCEPT_RTOL);
   *rules = R;
   R = NULL;
 cleanup:
@@ -317,5 +334,6 @@ cleanup:
   fcm__free(ctx, ref);
   fcm__free(ctx, walls);
   fcm_cell_rules_destroy(&R);
+  fcm_cell_rules_destroy(&least);
   return st;
 }
