@@ -152,5 +152,5 @@ int main(int argc, char **argv)
     fcm_scene_destroy(&scenes[--num_scenes]);
   free(v), free(rest), free(tri);
   fcm_ctx_destroy(&ctx);
-  TEST_RESULT();
+  return TEST_RESULT();
 }

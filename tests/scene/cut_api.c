@@ -11,7 +11,9 @@
  *   and whose outer ones beyond it (taken by the nearest element's motion).
  *   fcm_simulation_rest_positions() gives A^-1 (x - b) (1e-12) in the body, beyond it and
  *   beyond the mesh.
- * - A blade beyond the body is a counted miss; the run goes on.
+ * - A blade beyond the body is a counted miss; the run goes on. One through the cells above
+ *   the body keeps the run's rules and integrator, and its steps are those without the cut,
+ *   bit for bit; a crack into the body's top is a miss too, but makes them again.
  * - Refused, the run unchanged: NULL arguments, a frame out of range, a blade without area, a
  *   scene without geometry, every allocation failed in turn; a checkpoint after such a cut. */
 #include "scene_util.h"
@@ -415,6 +417,51 @@ static void element_search(fcm_ctx *ctx)
   drop_scenes();
 }
 
+/* A blade through the cells above the body, in the air (z = 0.6; the body's top is at 0.5 in
+ * cells 0.5 high): a miss that leaves the run's rules and integrator as they were, and its
+ * steps those of a run without the cut, bit for bit. A blade into the body's top, down to
+ * z = 0.3 (a crack: the material below joins its sides), also misses, but gives the pieces it
+ * divides faces on the cut (it counts from a cut that completes it): a new integrator. */
+static void miss_keeps_run(fcm_ctx *ctx)
+{
+  char buf[4096];
+  const char *fx = "{\"gravity\": {\"acceleration\": [0, 0, -9.81]}}";
+  fcm_simulation *a = make(ctx, box_scene(buf, sizeof buf, fx)),
+                 *b = make(ctx, box_scene(buf, sizeof buf, fx));
+  const double air[3] = {0.5, 0.25, 0.6}, up[3] = {0, 0, 1}, ax[3] = {1, 0, 0},
+               air_size[2] = {1.2, 0.7}, crack[3] = {0.6, 0.25, 0.55}, across[3] = {1, 0, 0},
+               vertical[3] = {0, 0, 1}, crack_size[2] = {0.5, 0.7};
+  fcm_surface *above = NULL, *into = NULL;
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, air, up, ax, air_size, &above));
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, crack, across, vertical, crack_size, &into));
+  if (a && b && above && into && steps(ctx, a, 2) && steps(ctx, b, 2)) {
+    fcm_cut_info info;
+    const fcm_integrator *I = fcm_simulation_integrator(b);
+    const fcm_cell_rules *R = fcm_simulation_cell_rules(b);
+    TEST_OK(ctx, fcm_simulation_cut(b, above, FCM_CUT_FRAME_REFERENCE, &info));
+    TEST_TRUE(info.missed && info.cells_integrated == 0 && info.seconds_integrator == 0.0);
+    TEST_TRUE(fcm_simulation_integrator(b) == I && fcm_simulation_cell_rules(b) == R);
+    steps(ctx, a, 2), steps(ctx, b, 2);
+    const fcm_index n = fcm_integrator_num_dofs(fcm_simulation_integrator(a));
+    TEST_TRUE(n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)));
+    if (n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)))
+      TEST_TRUE(memcmp(fcm_integrator_displacement(fcm_simulation_integrator(a)),
+                       fcm_integrator_displacement(fcm_simulation_integrator(b)),
+                       (size_t)n * sizeof(double)) == 0);
+    TEST_OK(ctx, fcm_simulation_cut(b, into, FCM_CUT_FRAME_REFERENCE, &info));
+    TEST_TRUE(info.missed && fcm_simulation_integrator(b) != I);
+    fcm_simulation_counters c;
+    fcm_simulation_get_counters(b, &c);
+    TEST_TRUE(c.cuts == 2 && c.cuts_missed == 2);
+    steps(ctx, b, 1);
+  }
+  fcm_surface_destroy(&above);
+  fcm_surface_destroy(&into);
+  fcm_simulation_destroy(&a);
+  fcm_simulation_destroy(&b);
+  drop_scenes();
+}
+
 static void misses_and_errors(fcm_ctx *ctx)
 {
   char buf[4096];
@@ -519,7 +566,8 @@ int main(void)
   element_search(ctx);
   deformed_frames(ctx);
   misses_and_errors(ctx);
+  miss_keeps_run(ctx);
   allocation_failures();
   fcm_ctx_destroy(&ctx);
-  TEST_RESULT();
+  return TEST_RESULT();
 }

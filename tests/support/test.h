@@ -58,7 +58,16 @@ static int test_failures_ = 0;
   } while (0)
 
 /* Exit status of a test's main(). */
-#define TEST_RESULT()                                                                              \
-  (test_failures_ ? (fprintf(stderr, "%d check(s) failed\n", test_failures_), 1) : 0)
+/* main's exit code: `return TEST_RESULT();` (a result left unused is a compile error under
+ * -Werror, so a failed check cannot end in exit code 0) */
+#if defined(__GNUC__)
+__attribute__((warn_unused_result))
+#endif
+static inline int test_result_(void)
+{
+  if (test_failures_) fprintf(stderr, "%d check(s) failed\n", test_failures_);
+  return test_failures_ ? 1 : 0;
+}
+#define TEST_RESULT() test_result_()
 
 #endif

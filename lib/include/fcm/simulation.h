@@ -360,9 +360,12 @@ typedef struct fcm_cut_info {
  * is the same, bit for bit, as the same blade given as a cut effect due before the next step.
  * A cut integrates only the elements it changes when the simulation was created with
  * fcm_simulation_options.host_cuts (or its scene has cut effects). A blade that misses the
- * body is no error (info->missed). Call it between steps, as often as the tool moves; every
- * process of a distributed run calls it with the same blade. The pointers the simulation gave
- * before (fcm_simulation_integrator(), _space(), _cell_rules()) are replaced.
+ * body is no error (info->missed); one that meets no material at all (no cell integrated
+ * again, no cut face) leaves a serial run's rules, space and integrator as they were, and its
+ * next steps those it would take without the cut. Call it between steps, as often as the tool
+ * moves; every process of a distributed run calls it with the same blade. The pointers the
+ * simulation gave before (fcm_simulation_integrator(), _space(), _cell_rules()) are replaced
+ * (kept by a blade that meets no material).
  * The counters count the cut (cuts, time_cut_*), and fcm_simulation_summary_view() lists it.
  * A checkpoint cannot hold such cuts (their blades are not in the scene):
  * fcm_simulation_write_checkpoint() refuses after one, and fcm_simulation_checkpoint_due() is

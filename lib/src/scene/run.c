@@ -547,6 +547,27 @@ cleanup:
   return st;
 }
 
+/* Whether the rules of a cut that missed (the same pieces and DOF copies) change nothing else,
+ * in a serial run: no cell integrated again and no piece with other faces on the cuts (a crack
+ * the blade leaves inside cells keeps their pieces and rules but gives them faces on it, and
+ * counts from the cut that completes it; a blade on the body's surface gives faces too). The
+ * blade then divides no part, now or after later cuts (their parts lie in these), so the run's
+ * rules, space and integrator serve as they are, and its next steps are those it would have
+ * taken without the cut, bit for bit. (On a body given by its surface alone a cell's parts
+ * include its empty part: a blade through it gives faces, and the run is made again.) */
+static int unchanged(const fcm_simulation *S, const fcm_cell_rules *rules)
+{
+  const fcm_cell_rules *old = S->rules;
+  if (fcm_cell_rules_get_stats(rules)->num_integrated != 0 || S->distributed ||
+      fcm__integrator_distributed(S->integ, NULL))
+    return 0;
+  for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(rules); p++)
+    if (fcm_cell_rules_get_piece_cut_faces(rules, p, NULL) !=
+        fcm_cell_rules_get_piece_cut_faces(old, p, NULL))
+      return 0;
+  return 1;
+}
+
 fcm_status fcm__sim_cut_along(fcm_simulation *S, const fcm_surface *surf, double at, double t0)
 {
   fcm_status st = FCM_OK;
@@ -583,9 +604,14 @@ fcm_status fcm__sim_cut_along(fcm_simulation *S, const fcm_surface *surf, double
   S->cut_phase[1] = fcm_wtime() - t0 - S->cut_phase[0];
   /* missed: no cell got a new piece and no node a new copy (a cut along cell faces adds copies
    * without splitting any cell) */
-  if (fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
-      fcm_space_num_dofs(space) == fcm_space_num_dofs(S->space))
-    S->c.cuts_missed++;
+  const int missed = fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
+                     fcm_space_num_dofs(space) == fcm_space_num_dofs(S->space);
+  S->c.cuts_missed += missed;
+  if (missed && unchanged(S, rules)) { /* the run goes on with its own (the new space goes) */
+    if (S->surf && S->surf->space == space)
+      FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
+    goto cleanup;
+  }
   FCM_TRY(ctx, cut_parts(S, space, &integ, &S->cut_phase[2]));
   /* the new integrator counts from zero: keep the totals so far */
   S->base_factorizations = S->c.factorizations;
