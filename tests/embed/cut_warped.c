@@ -317,9 +317,11 @@ static void flat_on_wall(const fcm__embed_cell *cell)
   for (int order = 0; order < 2; order++) {
     const double lo[3] = {0.2, 0.5 - 1e-11, 0.3}, hi[3] = {0.8, 0.5 + 1e-11, 0.7};
     double X[24];
-    for (int c = 0; c < 8; c++) /* the box's corners in the Hex8 order */
+    for (int c = 0; c < 8; c++) { /* the box's corners in the Hex8 order */
+      const int at_hi[3] = {(c & 1) ^ (c >> 1 & 1), c >> 1 & 1, c >> 2};
       for (int d = 0; d < 3; d++)
-        X[3 * c + d] = ((d == 0 ? (c & 1) ^ (c >> 1 & 1) : d == 1 ? c >> 1 & 1 : c >> 2) ? hi : lo)[d];
+        X[3 * c + d] = at_hi[d] ? hi[d] : lo[d];
+    }
     fcm__geom_poly_from_cell(FCM_ELEMENT_HEX8, X, q);
     const double v0 = fcm__geom_poly_volume(q);
     P->n = 0;

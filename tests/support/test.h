@@ -61,7 +61,7 @@ static int test_failures_ = 0;
 /* main's exit code: `return TEST_RESULT();` (a result left unused is a compile error under
  * -Werror, so a failed check cannot end in exit code 0) */
 #if defined(__GNUC__)
-__attribute__((warn_unused_result))
+static inline int test_result_(void) __attribute__((warn_unused_result));
 #endif
 static inline int test_result_(void)
 {
