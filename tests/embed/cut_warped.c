@@ -145,13 +145,15 @@ typedef struct unit_body {
   const fcm_mesh *mesh;
   fcm_geometry *box;
   fcm_cell_rules *rules;
+  fcm_surface *across; /* the plane x = 0.37, cut after a cut taken in its least change */
   int accepted, wrong; /* cuts taken in the attempt of least change; cuts with other pieces */
 } unit_body;
 
 /* The cut s through the unit body: it goes through (the split's volume change is within the
  * tolerance's layer, 1e-9 of the cell, if no shift resolves it), into two pieces, each with its
  * centre (from its rule's first moments) on one side of the sheet, farther than 3 amp from it
- * (height h). */
+ * (height h). After a cut taken so, a plane across it goes through at once, without a
+ * degenerate cell (the earlier cut's change is not the new one's). */
 static void unit_cut(unit_body *U, const fcm_surface *s, double amp, double (*h)(const double *))
 {
   fcm_cell_rules *r = NULL;
@@ -160,6 +162,13 @@ static void unit_cut(unit_body *U, const fcm_surface *s, double amp, double (*h)
   const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(r);
   U->accepted += S->num_degenerate > 0;
   TEST_TRUE(S->split_change <= 1e-9);
+  if (S->num_degenerate > 0 && U->across) { /* the next cut is judged by its own change */
+    fcm_cell_rules *r2 = NULL;
+    TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, U->mesh, U->box, r, U->across, &r2));
+    const fcm_cell_rules_stats *S2 = r2 ? fcm_cell_rules_get_stats(r2) : NULL;
+    TEST_TRUE(S2 && S2->cut_attempts == 1 && S2->num_degenerate == 0);
+    fcm_cell_rules_destroy(&r2);
+  }
   const fcm_index np = fcm_cell_rules_num_pieces(r);
   int side = 0, ok = np == 2;
   for (fcm_index p = 0; p < np && ok; p++) {
@@ -378,8 +387,10 @@ int main(int argc, char **argv)
   if (mesh) {
     TEST_OK(ctx, fcm__embed_cell_setup(ctx, mesh, 0, 1e-10, &cell));
     if (!study) flat_on_wall(&cell);
-    unit_body U = {mesh, NULL, NULL, 0, 0};
+    unit_body U = {mesh, NULL, NULL, NULL, 0, 0};
     const fcm_index n1[3] = {1, 1, 1};
+    const double ac[3] = {0.37, 0.5, 0.5}, an[3] = {1, 0, 0}, aa[3] = {0, 1, 0}, as[2] = {2, 2};
+    TEST_OK(ctx, fcm_surface_create_rectangle(ctx, ac, an, aa, as, &U.across));
     fcm_cell_rules_options o = fcm_cell_rules_options_default();
     o.min_fraction = 0.0;
     TEST_OK(ctx, fcm_geometry_create_box(ctx, ulo, uhi, n1, &U.box));
@@ -405,6 +416,7 @@ int main(int argc, char **argv)
     }
     fcm_cell_rules_destroy(&U.rules);
     fcm_geometry_destroy(&U.box);
+    fcm_surface_destroy(&U.across);
   }
   fcm_mesh_destroy(&mesh);
   fcm_ctx_destroy(&ctx);

@@ -147,5 +147,5 @@ int main(int argc, char **argv)
   fcm_mesh_destroy(&mesh);
   TEST_TRUE(fcm_ctx_live_allocations(ctx) == 0);
   fcm_ctx_destroy(&ctx);
-  return 0;
+  return TEST_RESULT();
 }

@@ -218,8 +218,8 @@ typedef struct fcm_cell_rules_stats {
                                       on one side only, an empty cell, a cut along a face); their
                                       class, fraction, pieces and rules are copied bit for bit,
                                       their cut faces made again */
-  fcm_index num_degenerate;      /**< cells whose splitting by the cuts changed their parts'
-                                      volume by more than 1e-12 of the cell's (after a
+  fcm_index num_degenerate;      /**< cells whose splitting by the new cut changed their
+                                      parts' volume by more than 1e-12 of the cell's (after a
                                       successful fcm_cell_rules_create_cut() 0, unless no shift
                                       resolved them and each change is within the tolerance's
                                       layer, 1e-9: split_change) */
@@ -271,10 +271,11 @@ typedef struct fcm_cell_rules_stats {
                             surface rule carries (their traction or Nitsche terms are lost);
                             embedded_area + dropped_area is the surface's area. Computed only
                             when surface rules are built (surface_strength >= 0), else 0 */
-  double split_change; /**< the largest change of a cell's parts' volume by the cuts'
+  double split_change; /**< the largest change of a cell's parts' volume by the new cut's
                             splitting, relative to the cell's volume (rounding, about 1e-15;
                             above 1e-12 in the cells num_degenerate counts; at most 1e-9 after
-                            a successful fcm_cell_rules_create_cut()) */
+                            a successful fcm_cell_rules_create_cut(); each cut's adds to the
+                            earlier ones') */
 } fcm_cell_rules_stats;
 
 /** Per-cell quadrature of an embedded geometry in a background mesh (opaque). */

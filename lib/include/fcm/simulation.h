@@ -361,8 +361,9 @@ typedef struct fcm_cut_info {
  * A cut integrates only the elements it changes when the simulation was created with
  * fcm_simulation_options.host_cuts (or its scene has cut effects). A blade that misses the
  * body is no error (info->missed); one that meets no material at all (no cell integrated
- * again, no cut face) leaves a serial run's rules, space and integrator as they were, and its
- * next steps those it would take without the cut. Call it between steps, as often as the tool
+ * again, no cut face) leaves a serial run's rules, space and integrator as they were (the
+ * rules then do not count it: fcm_cell_rules_num_cuts()), and its next steps those it would
+ * take without the cut. Call it between steps, as often as the tool
  * moves; every process of a distributed run calls it with the same blade. The pointers the
  * simulation gave before (fcm_simulation_integrator(), _space(), _cell_rules()) are replaced
  * (kept by a blade that meets no material).

@@ -262,8 +262,10 @@ fcm_status fcm__cell_rules_create_cut_keep(fcm_ctx *ctx, const fcm_mesh *mesh,
    * splitting changes their volume) is shifted by a small deterministic translation and
    * applied again: 1e-7, 1e-6, then 1e-5 of the mean cell size, along a fixed direction
    * with no rational relation to the axes. If none resolves it, the attempt whose largest
-   * volume change is least is taken when that change is the tolerance's own (kept, not made
-   * again). */
+   * volume change is least is taken when that change is the tolerance's own (kept while the
+   * next attempts are made, two sets of rules at once, rather than made again). A cell's
+   * change is the new cut's alone (fcm__embed_cell_pieces()): an earlier cut taken so would
+   * otherwise make every later one through its cells degenerate. */
   const double h = mean_cell_size(mesh);
   static const double dir[3] = {0.4636476090008061, 0.5880026035475675, 0.6628738660715610};
   static const double shift[CUT_ATTEMPTS] = {0.0, 1e-7, 1e-6, 1e-5};

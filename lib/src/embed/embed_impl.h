@@ -366,7 +366,8 @@ typedef struct fcm__parts {
   int *fmeta;
   size_t nfx, capfx, nfp, capfp;
   int *uf;            /* union-find scratch, n entries */
-  double split_error; /* |parts' volume after the splits - before| (fcm__embed_cell_pieces) */
+  double split_error; /* |parts' volume after the new cut's splits - before| (the splits by
+                         the triangles from first_new on, fcm__embed_cell_pieces) */
   size_t ufcap;
   /* A geometry without a volume mesh (surface_parts.c): the parts are the cell split by the
    * cuts, mvol[i] the body's volume inside part i (parts without are dropped), and parts join
@@ -393,9 +394,10 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
  * numbered by their first part, are the pieces (P->piece, P->num_pieces). The triangles are
  * taken in ascending order; those below first_new are the earlier cuts: the pieces under
  * them alone (what the rules being extended had) are P->parent / P->num_parents, one piece
- * when none of them reaches the cell. P->split_error: how much the splits changed the parts'
- * total volume (rounding only, unless the cuts meet the parts in a degenerate way the
- * tolerances cannot resolve).*/
+ * when none of them reaches the cell. P->split_error: how much the new cut's splits (the
+ * triangles from first_new on) changed the parts' total volume (rounding only, unless the cut
+ * meets the parts in a degenerate way the tolerances cannot resolve; the earlier cuts' splits
+ * change it as they did when they were made, which shifting the new cut cannot change). */
 fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
                                   const fcm__cut_tri *tris, fcm_index first_new, fcm__parts *P);
 
@@ -522,7 +524,9 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
 
 /* Whether two faces on one plane join their convex parts (vertices va, nva and vb, nvb): face
  * a (na vertices) and the convex face b (nb vertices, counter-clockwise around nb_normal)
- * overlap by more than `atol` in area, and unless the overlap lies on the cuts
+ * overlap by more than `atol` in area (where the overlap touches a cut triangle, in a polygon
+ * wider than 4 tol, 2 area / perimeter: a sliver face's band of tolerance reaches across the
+ * cut), and unless the overlap lies on the cuts
  * tris[ids[0 .. n)] (fcm__embed_on_cut(), twice the tolerance `tol`), in which case the
  * parts join only when they do not lie on opposite sides of the cut triangle under the
  * overlap's centroid (a part within tol of the plane, or crossing it, lies on no side).

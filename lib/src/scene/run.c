@@ -607,11 +607,8 @@ fcm_status fcm__sim_cut_along(fcm_simulation *S, const fcm_surface *surf, double
   const int missed = fcm_cell_rules_num_pieces(rules) == fcm_cell_rules_num_pieces(S->rules) &&
                      fcm_space_num_dofs(space) == fcm_space_num_dofs(S->space);
   S->c.cuts_missed += missed;
-  if (missed && unchanged(S, rules)) { /* the run goes on with its own (the new space goes) */
-    if (S->surf && S->surf->space == space)
-      FCM_TRY(ctx, fcm_embedded_surface_set_space(S->surf, S->space));
-    goto cleanup;
-  }
+  if (missed && unchanged(S, rules))
+    goto cleanup; /* the run goes on with its own; the new space gives the pattern back */
   FCM_TRY(ctx, cut_parts(S, space, &integ, &S->cut_phase[2]));
   /* the new integrator counts from zero: keep the totals so far */
   S->base_factorizations = S->c.factorizations;
