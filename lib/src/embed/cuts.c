@@ -358,12 +358,11 @@ static int within_reach_box(const fcm__embed_cell *cell, const double lo[3], con
 
 /* The links across one face shared by cells c (its face f) and c2 (its face f2), `cell` set
  * up for c: a polygon of a piece of c on the face overlaps a polygon of a piece of c2 on its
- * face with positive area (where it touches a cut triangle, wider than the tolerance's band:
- * fcm__embed_linked()), the overlap does not lie on a cut triangle, their parents were
- * linked (earlier_link()) and, without a volume mesh (`mat`), the overlap holds material.
- * The overlap test does not need equal faces, so a fine face inside a coarse one (an octree's
- * non-conforming face) is tested alike. Each link is stored from the piece of the
- * lower-numbered cell. */
+ * face with positive area, wider than the tolerance's band (fcm__embed_linked()), the overlap does
+ * not lie on a cut triangle, their parents were linked (earlier_link()) and, without a volume mesh
+ * (`mat`), the overlap holds material. The overlap test does not need equal faces, so a fine face
+ * inside a coarse one (an octree's non-conforming face) is tested alike. Each link is stored from
+ * the piece of the lower-numbered cell. */
 static fcm_status face_links(const build *B, const fcm_cell_rules *R, const cell_out *out,
                              const fcm__embed_cell *cell, fcm_index c, int f, fcm_index c2, int f2,
                              fcm__material *mat, fcm__idbuf *tc, fcm_index **links, size_t *nl,

@@ -524,9 +524,9 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
 
 /* Whether two faces on one plane join their convex parts (vertices va, nva and vb, nvb): face
  * a (na vertices) and the convex face b (nb vertices, counter-clockwise around nb_normal)
- * overlap by more than `atol` in area (where the overlap touches a cut triangle, in a polygon
- * wider than 4 tol, 2 area / perimeter: a sliver face's band of tolerance reaches across the
- * cut), and unless the overlap lies on the cuts
+ * overlap by more than `atol` in area, in a polygon wider than 4 tol (2 area / perimeter: a
+ * sliver face's band of tolerance can reach across a cut), and unless the overlap lies on the
+ * cuts
  * tris[ids[0 .. n)] (fcm__embed_on_cut(), twice the tolerance `tol`), in which case the
  * parts join only when they do not lie on opposite sides of the cut triangle under the
  * overlap's centroid (a part within tol of the plane, or crossing it, lies on no side).

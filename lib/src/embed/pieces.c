@@ -1,10 +1,10 @@
 /* Cutting (XFEM) inside one background cell: the convex parts of the embedded
  * geometry are split by the plane of every cut triangle that reaches them and by the
  * triangle's three edge planes, so that every new face lies wholly on or wholly off the
- * triangle; parts that share a face of positive area not lying on a cut triangle (and, where
- * it touches one, wider than the tolerance's band) are connected; the connected components
- * are the cell's material pieces. Each piece then goes
- * through the same tetrahedralize -> map -> simplify -> stabilize path as a cut cell.
+ * triangle; parts that share a face of positive area, wider than the tolerance's band, not
+ * lying on a cut triangle are connected; the connected components are the cell's material
+ * pieces. Each piece then goes through the same tetrahedralize -> map -> simplify -> stabilize
+ * path as a cut cell.
  *
  * Robustness: each part vertex is classified once per plane with the cuts' tolerance
  * (fcm__geom_poly_clip), and both halves of a split are made from the same signed
@@ -26,8 +26,8 @@
 
 /* Relative tolerances of the connectivity tests: faces match when they face each other and
  * the vertices of each lie within MATCH_RTOL x the cell size of the other's plane, and they
- * overlap by more than AREA_RTOL x size^2 (near a cut, in a polygon wider than WIDE_FACTOR x
- * MATCH_RTOL x size: overlap_shared()). (Comparing the planes' normals and offsets
+ * overlap by more than AREA_RTOL x size^2 in a polygon wider than WIDE_FACTOR x MATCH_RTOL x
+ * size (overlap_shared()). (Comparing the planes' normals and offsets
  * instead would let a face tilted 1e-6 off a cell face through the origin pass for one lying
  * on it, however far its vertices are.) */
 #define MATCH_RTOL FCM__EMBED_MATCH_RTOL
@@ -36,8 +36,7 @@
  * matching tolerance of a cut triangle: clipping one face by the other's edges places new
  * vertices on segments between points within the tolerance, up to rounding. */
 #define ON_CUT_FACTOR 2.0
-/* A shared face touching a cut is wider than this many times the matching tolerance
- * (overlap_shared()). */
+/* A shared face is wider than this many times the matching tolerance (overlap_shared()). */
 #define WIDE_FACTOR 4.0
 
 void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P)
@@ -371,14 +370,14 @@ static int point_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n
 }
 
 /* Whether the overlap x (m vertices) of two faces is one they share: more than atol of area,
- * and, where it touches a cut triangle, wider than the band the tolerance alone makes. Faces
- * within tol of each other's planes overlap up to tol beyond the edges of each, so a sliver
- * face of no width overlaps a face across it in a band up to 2 tol wide; and a nearly zero
- * edge of a sliver has an edge plane that can point anywhere, so the band can run far past
- * the sliver's end, across a cut surface between parts on its two sides. There the polygon's
- * 2 area / perimeter (a strip's width) must exceed WIDE_FACTOR x tol. */
-static int overlap_shared(const double *x, int m, double atol, double tol, const fcm__cut_tri *tris,
-                          const fcm_index *ids, size_t n)
+ * and wider than the band the tolerance alone makes. Faces within tol of each other's planes
+ * overlap up to tol beyond the edges of each, so a sliver face of no width overlaps a face
+ * across it in a band up to 2 tol wide; and a nearly zero edge of a sliver has an edge plane
+ * that can point anywhere, so the band can run far past the sliver's end, across a cut surface
+ * between parts on its two sides (with no vertex near the cut: the band's ends lie on either
+ * side of it). The polygon's 2 area / perimeter (a strip's width) must exceed WIDE_FACTOR x
+ * tol; a part that touches others only through such strips becomes a piece of its own. */
+static int overlap_shared(const double *x, int m, double atol, double tol)
 {
   const double area = polygon_area(x, m);
   if (!(area > atol)) return 0;
@@ -388,10 +387,7 @@ static int overlap_shared(const double *x, int m, double atol, double tol, const
     const double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
     perimeter += sqrt(fcm__vec3_dot(e, e));
   }
-  if (2.0 * area > WIDE_FACTOR * tol * perimeter) return 1;
-  for (int k = 0; k < m; k++) /* a narrow strip: shared unless it touches a cut */
-    if (point_on_cut(tris, ids, n, x + 3 * k, ON_CUT_FACTOR * tol)) return 0;
-  return 1;
+  return 2.0 * area > WIDE_FACTOR * tol * perimeter;
 }
 
 int fcm__embed_on_cut(const fcm__cut_tri *tris, const fcm_index *ids, size_t n, const double *x,
@@ -454,7 +450,7 @@ int fcm__embed_linked(const double *a, int na, const double *va, int nva, const 
   double x[3 * FCM__POLY_MAX_VERTS];
   int m = 0;
   fcm__embed_overlap(a, na, b, nb, nb_normal, tol, x, &m);
-  if (m < 3 || !overlap_shared(x, m, atol, tol, tris, ids, n)) return 0;
+  if (m < 3 || !overlap_shared(x, m, atol, tol)) return 0;
   return overlap_linked(x, m, va, nva, vb, nvb, tol, tris, ids, n);
 }
 
@@ -713,7 +709,7 @@ static int faces_linked(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cu
   for (int k = 0; k < nb && m >= 3; k++)
     if (!zero_plane(ep + k))
       m = fcm__geom_polygon_clip(x, m, FCM__POLY_MAX_VERTS, ep + k, mtol, 1, work);
-  if (m < 3 || !overlap_shared(x, m, atol, mtol, tris, P->tcand.ids, ntri)) return 0;
+  if (m < 3 || !overlap_shared(x, m, atol, mtol)) return 0;
   const fcm__poly *pa = P->poly + i, *pb = P->poly + j;
   return overlap_linked(x, m, pa->x[0], pa->nv, pb->x[0], pb->nv, mtol, tris, P->tcand.ids, ntri) &&
          (!P->mat || fcm__embed_part_full(P, (size_t)i) || fcm__embed_part_full(P, (size_t)j) ||
