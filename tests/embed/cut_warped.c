@@ -18,10 +18,10 @@
  * farther than 3 amp from the smooth sheet on its piece's side). The same for 500 sheets over a
  * wider range (amp 1e-5 to 1e-2, 2 to 11 squares a side; at most 1 in 10 degenerate): there
  * sliver parts thinner than the tolerance touch parts on both sides, and a link through a
- * sliver's face joined the two sides (2 of the 500 before overlaps had to be wider than the
- * tolerance's band). `embed_cut_warped study N` counts N sheets over the wider range without
- * asserting (lib/docs/cutting.md). A slab thinner than the tolerance lying on the wall of two
- * folded triangles is split by exactly one of them, into a part on each side.
+ * sliver's face joins the two sides unless a shared face must be wider than the tolerance's
+ * band (2 of the 500 without that). `embed_cut_warped study N` counts N sheets over the wider
+ * range without asserting (lib/docs/cutting.md). A slab thinner than the tolerance lying on the
+ * wall of two folded triangles is split by exactly one of them, into a part on each side.
  * The triangles' columns meet on one wall per shared edge, and a triangle splits by its plane
  * only what lies in its column: with each triangle's own perpendicular edge planes, or its
  * plane extended outside its column, cells hold thin slabs between nearly coplanar planes that

@@ -80,6 +80,17 @@ static int steps(fcm_ctx *ctx, fcm_simulation *sim, int n)
   return 1;
 }
 
+/* a and b have as many DOFs and the same displacement, bit for bit. */
+static void same_displacement(fcm_simulation *a, fcm_simulation *b)
+{
+  const fcm_integrator *ia = fcm_simulation_integrator(a), *ib = fcm_simulation_integrator(b);
+  const fcm_index n = fcm_integrator_num_dofs(ia);
+  TEST_TRUE(n == fcm_integrator_num_dofs(ib));
+  if (n == fcm_integrator_num_dofs(ib))
+    TEST_TRUE(memcmp(fcm_integrator_displacement(ia), fcm_integrator_displacement(ib),
+                     (size_t)n * sizeof(double)) == 0);
+}
+
 /* The log as text without its wall_time column (the last). */
 static char *log_text(fcm_simulation *sim)
 {
@@ -123,12 +134,7 @@ static void reference_is_the_effect(fcm_ctx *ctx, int host_cuts)
     TEST_TRUE(info.dofs_after == fcm_space_num_dofs(fcm_simulation_space(b)));
     TEST_TRUE(info.cells_integrated > 0 && info.seconds >= info.seconds_rules);
     steps(ctx, b, 3);
-    const fcm_index n = fcm_integrator_num_dofs(fcm_simulation_integrator(a));
-    TEST_TRUE(n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)));
-    if (n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)))
-      TEST_TRUE(memcmp(fcm_integrator_displacement(fcm_simulation_integrator(a)),
-                       fcm_integrator_displacement(fcm_simulation_integrator(b)),
-                       (size_t)n * sizeof(double)) == 0);
+    same_displacement(a, b);
     char *la = log_text(a), *lb = log_text(b);
     TEST_TRUE(la && lb && strcmp(la, lb) == 0);
     free(la), free(lb);
@@ -442,12 +448,7 @@ static void miss_keeps_run(fcm_ctx *ctx)
     TEST_TRUE(info.missed && info.cells_integrated == 0 && info.seconds_integrator == 0.0);
     TEST_TRUE(fcm_simulation_integrator(b) == I && fcm_simulation_cell_rules(b) == R);
     steps(ctx, a, 2), steps(ctx, b, 2);
-    const fcm_index n = fcm_integrator_num_dofs(fcm_simulation_integrator(a));
-    TEST_TRUE(n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)));
-    if (n == fcm_integrator_num_dofs(fcm_simulation_integrator(b)))
-      TEST_TRUE(memcmp(fcm_integrator_displacement(fcm_simulation_integrator(a)),
-                       fcm_integrator_displacement(fcm_simulation_integrator(b)),
-                       (size_t)n * sizeof(double)) == 0);
+    same_displacement(a, b);
     TEST_OK(ctx, fcm_simulation_cut(b, into, FCM_CUT_FRAME_REFERENCE, &info));
     TEST_TRUE(info.missed && fcm_simulation_integrator(b) != I);
     fcm_simulation_counters c;

@@ -526,8 +526,7 @@ double fcm__embed_overlap(const double *a, int na, const double *b, int nb,
  * a (na vertices) and the convex face b (nb vertices, counter-clockwise around nb_normal)
  * overlap by more than `atol` in area, in a polygon wider than 4 tol (2 area / perimeter: a
  * sliver face's band of tolerance can reach across a cut), and unless the overlap lies on the
- * cuts
- * tris[ids[0 .. n)] (fcm__embed_on_cut(), twice the tolerance `tol`), in which case the
+ * cuts tris[ids[0 .. n)] (fcm__embed_on_cut(), twice the tolerance `tol`), in which case the
  * parts join only when they do not lie on opposite sides of the cut triangle under the
  * overlap's centroid (a part within tol of the plane, or crossing it, lies on no side).
  * Deciding by the parts' sides rather than by where each cell placed the cut: the crossing of
