@@ -350,15 +350,16 @@ int write_event(soup *s, const char *dir, const char *surf_dir, const char *name
 }
 
 /* Dick: a grid of six square blades (three across x, three across z) pushed down into the
- * body from above in four steps, each step cutting the next band of depth. */
-static int dick_cuts(const cutbench_model *m, const char *dir, const char *surf_dir,
+ * body from above in `events` steps (every other step), each step cutting the next band of
+ * depth; the bands share their edges, so any count cuts the same surface in the end. */
+static int dick_cuts(const cutbench_model *m, int events, const char *dir, const char *surf_dir,
                      const char *name, cutbench_scene *sc)
 {
   static const double frac[3] = {0.253, 0.507, 0.741};
   const double Ly = m->hi[1] - m->lo[1], top = m->hi[1] + 0.02 * Ly, depth = 0.57 * Ly;
   soup s = {0};
   s.ok = 1;
-  sc->events = 4;
+  sc->events = events;
   int ok = 1;
   for (int k = 0; k < sc->events; k++) {
     sc->event_step[k] = 2 + 2 * k;
@@ -376,7 +377,7 @@ static int dick_cuts(const cutbench_model *m, const char *dir, const char *surf_
   }
   soup_clear(&s);
   free(s.x), free(s.t);
-  sc->steps = 9;
+  sc->steps = 2 * events + 1;
   return ok;
 }
 
@@ -484,8 +485,8 @@ int scene_box_grid(cutbench_text *t, const double L[3], double h, const fcm_inde
 }
 
 int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const char *body,
-                         double scale, const char *solver, const char *dir, const char *surf_dir,
-                         const char *name, cutbench_scene *sc)
+                         double scale, int dick_events, const char *solver, const char *dir,
+                         const char *surf_dir, const char *name, cutbench_scene *sc)
 {
   static cutbench_text t;
   const cutbench_paper *p = &cutbench_papers[row];
@@ -505,13 +506,23 @@ int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const cha
     ok = cutbench_tonthat_octopus(&t, p, scale, m->triangles, solver, dir, surf_dir, name, sc);
   else if (row <= ROW_DICK_BUNNY) {
     sc->h = size_for(m->volume, m->area, target, 0.75);
-    ok = dick_cuts(m, dir, surf_dir, name, sc);
-    char desc[512];
+    if (dick_events < 1 || dick_events > CUTBENCH_MAX_EVENTS) {
+      fprintf(stderr, PROG ": Dick's cut events: %d, not in [1, %d]\n", dick_events,
+              CUTBENCH_MAX_EVENTS);
+      return 0;
+    }
+    ok = dick_cuts(m, dick_events, dir, surf_dir, name, sc);
+    static const char *const words[CUTBENCH_MAX_EVENTS + 1] = {
+        "",     "one", "two",    "three",  "four",     "five",     "six",     "seven",  "eight",
+        "nine", "ten", "eleven", "twelve", "thirteen", "fourteen", "fifteen", "sixteen"};
+    char desc[512], steps[64] = "in one step (one cut)";
+    if (dick_events > 1)
+      snprintf(steps, sizeof steps, "in %s steps (one cut per step)", words[dick_events]);
     snprintf(desc, sizeof desc,
              "After Dick et al. 2011 (Table 1, %s): a bunny-like body on a Hex8 grid sized to "
              "about %.0f active cells, corotated linear, its base held under gravity; a grid of "
-             "six square blades is pushed down into it in four steps (one cut per step).",
-             p->model, target);
+             "six square blades is pushed down into it %s.",
+             p->model, target, steps);
     scene_head(&t, name, desc, m, body, sc->h, p->material, 1e5, 0.4, solver, 0.01, sc->steps);
     cutbench_put(&t, "    {\"gravity\": {\"acceleration\": [0, -9.81, 0]}},\n");
     cutbench_put(

@@ -47,6 +47,7 @@ static const char *const row_interactive[ROW_COUNT] = {
 
 typedef struct settings {
   int quick, fill_holes, repeat;
+  int dick_events; /* cut events of Dick's rows */
   double scale;
   long long triangles;
   const char *model, *rows, *interactive, *csv, *png, *write_scenes;
@@ -72,7 +73,8 @@ static void usage(FILE *f, const cli_option *opts)
           "figures, with the targets: cut <= the paper's; mean step <= paper/2 (Dick) or\n"
           "paper/10 (Koschier, Ton-That). Rows:\n"
           "  dick-bunny3, dick-bunny2, dick-bunny  Dick 2011 Table 1: a grid of blades pushed\n"
-          "      into the bunny in four steps; 5.48k, 26.1k, 118k active Hex8 cells; corotated\n"
+          "      into the bunny in four steps (--dick-events); 5.48k, 26.1k, 118k active Hex8\n"
+          "      cells; corotated\n"
           "  koschier-bunny  Koschier 2017 7: a groove carved into the turning bunny, then\n"
           "      peeled off; 5,326 DOFs; Stable Neo-Hookean\n"
           "  koschier-plate  Koschier 2017 7: a plate with attached objects (a generated\n"
@@ -99,7 +101,7 @@ static void usage(FILE *f, const cli_option *opts)
              "1 when a row failed, 2 on a usage error (nothing is written).\n");
 }
 
-#define NUM_OPTIONS 13
+#define NUM_OPTIONS 14
 static void option_table(settings *o, cli_option opts[NUM_OPTIONS])
 {
   const cli_option t[NUM_OPTIONS] = {
@@ -119,6 +121,10 @@ static void option_table(settings *o, cli_option opts[NUM_OPTIONS])
       {"--surface-triangles", NULL, CLI_LLONG, &o->triangles, "N",
        "triangles of the generated bodies: the bunny, the\nplate, the octopus (default 70000)", 48,
        5e6, 0, NULL, NULL, &o->seen_triangles},
+      {"--dick-events", NULL, CLI_INT, &o->dick_events, "N",
+       "Dick's rows: the blades pushed in N cut events, each\nthe next band of depth (1: the whole "
+       "depth at once;\ndefault 4)",
+       1, CUTBENCH_MAX_EVENTS, 0, NULL, NULL, NULL},
       {"--interactive", NULL, CLI_STRING, &o->interactive, "MEMBERS",
        "an option set run beside the defaults, as members of\nthe scene's \"solver\" object, "
        "e.g. '\"method\": \"cg\"'",
@@ -143,7 +149,7 @@ static void option_table(settings *o, cli_option opts[NUM_OPTIONS])
 static int parse_options(int argc, char **argv, settings *o)
 {
   memset(o, 0, sizeof *o);
-  o->scale = 1.0, o->triangles = 70000, o->repeat = 1;
+  o->scale = 1.0, o->triangles = 70000, o->repeat = 1, o->dick_events = 4;
   cli_option opts[NUM_OPTIONS];
   option_table(o, opts);
   const int rc = cli_parse_args(PROG, opts, argc, argv, NULL, 0, NULL, usage);
@@ -370,8 +376,8 @@ static int write_scenes(fcm_ctx *ctx, const settings *o)
       if (*c == '-') *c = '_';
     cutbench_scene sc;
     if (!cutbench_write_scene((cutbench_row_id)r, &m,
-                              o->model ? m.path : "models/cutbench_body.obj", o->scale, "",
-                              o->write_scenes, "models/cutbench", name, &sc))
+                              o->model ? m.path : "models/cutbench_body.obj", o->scale,
+                              o->dick_events, "", o->write_scenes, "models/cutbench", name, &sc))
       return 1;
     printf("%s: h = %.6g m, %d steps, %d cut events\n", sc.json_path, sc.h, sc.steps, sc.events);
   }
@@ -471,8 +477,8 @@ static int run_row(const settings *o, const cutbench_model *m, const char *dir, 
   for (int k = 0; k < sets; k++) {
     char name[128];
     snprintf(name, sizeof name, "%s%s", p->row, k ? "-interactive" : "");
-    written[k] = cutbench_write_scene(row->id, m, m->path, o->scale, k ? inter : "", dir, "cuts",
-                                      name, &sc[k]);
+    written[k] = cutbench_write_scene(row->id, m, m->path, o->scale, o->dick_events, k ? inter : "",
+                                      dir, "cuts", name, &sc[k]);
     if (!written[k]) {
       row->run[k].ran = 1;
       snprintf(row->run[k].note, sizeof row->run[k].note, "the scene could not be written");

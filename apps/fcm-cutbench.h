@@ -87,11 +87,13 @@ int cutbench_model_measure(fcm_ctx *ctx, cutbench_model *m);
 
 /** Write row `row`'s scene into directory `dir` (the scene `<dir>/<name>.json`, its cut
  * surfaces `<dir>/<surf_dir>/<name>_cut<k>.obj`): sized to `scale` times the paper's size,
- * the body `body` (a path as the scene will name it: relative to dir, or absolute), `solver`
- * the members of the scene's solver object ("" for the defaults). 1 on success. */
+ * the body `body` (a path as the scene will name it: relative to dir, or absolute), Dick's
+ * blades pushed in `dick_events` cut events (1 to CUTBENCH_MAX_EVENTS; the other rows have
+ * their own), `solver` the members of the scene's solver object ("" for the defaults). 1 on
+ * success. */
 int cutbench_write_scene(cutbench_row_id row, const cutbench_model *m, const char *body,
-                         double scale, const char *solver, const char *dir, const char *surf_dir,
-                         const char *name, cutbench_scene *out);
+                         double scale, int dick_events, const char *solver, const char *dir,
+                         const char *surf_dir, const char *name, cutbench_scene *out);
 
 /** What one run of a row's scene measured. */
 typedef struct cutbench_run {

@@ -7,13 +7,15 @@
  * the paper's and the verdicts follow from them; both runs of a row end on the same DOFs and
  * differ in displacement by less than a tenth of the largest displacement. The PNG is a PNG
  * (with gnuplot). --write-scenes writes scenes that parse. Bad options (--repeat outside [1, 99]
- * among them) exit 2 and write no CSV.
+ * and --dick-events outside [1, 16] among them) exit 2 and write no CSV.
  * Every run's count of runs is 1 and its ranges its figures. Mode rows (label app): the rows
  * left out of --quick — the accordion runs at 0.1 of its size, three times (--repeat 3: both
  * option sets ok, every figure finite and inside its range over the three runs, which all
  * ended alike; its five cut events add DOFs, at least one Newton iteration a step, the same
  * DOFs in both sets); the plate's, accordion's and octopus's scenes
- * written with --write-scenes parse with their cut events.
+ * written with --write-scenes parse with their cut events; Dick's Bunny 3 with its blades
+ * pushed in one event and in three (--dick-events) ends on the same DOFs, and its scene with
+ * eight events has eight cut effects.
  * Mode full (label bench): every row at the papers' sizes runs, the defaults ok, the program's
  * interactive sets ok or skipped (a build without their keys).
  * Usage: app_cutbench quick|rows|full PATH_TO_fcm-cutbench WORK_DIR */
@@ -205,7 +207,9 @@ static void quick(const char *prog, const char *work)
                                     "--interactive '{\"rtol\": 1}'",
                                     "--model x.obj --surface-triangles 100",
                                     "--repeat 0",
-                                    "--repeat 100"};
+                                    "--repeat 100",
+                                    "--dick-events 0",
+                                    "--dick-events 17"};
   for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
     remove(csv);
     snprintf(cmd, sizeof cmd, "'%s' %s --csv '%s' 2> /dev/null", prog, bad[k], csv);
@@ -237,6 +241,41 @@ static void check_scenes(const char *prog, const char *work, const char *sub, co
   fcm_ctx_destroy(&ctx);
 }
 
+/* Dick's blades pushed in one event and in three: the bands share their edges, so both cut
+ * the same surface and end with the same DOFs (a band that left a gap or an overlap would
+ * change the pieces), each event is one cut effect, and a step follows every other one. The
+ * interactive set is quick's (no multigrid structure made beside the integrator, so the
+ * phases add up to the latency as check_run() asks). */
+static void dick_events(const char *prog, const char *work)
+{
+  char cmd[8192], csv[1024];
+  static crow rows[4];
+  double dofs[2] = {-1.0, -2.0};
+  static const int n_events[2] = {1, 3};
+  for (int k = 0; k < 2; k++) {
+    snprintf(csv, sizeof csv, "%s/cutbench-dick-events%d.csv", work, n_events[k]);
+    remove(csv);
+    snprintf(cmd, sizeof cmd,
+             "'%s' --rows dick-bunny3 --scale 0.1 --surface-triangles 2000 --dick-events %d "
+             "--interactive '\"newton\": {\"rtol\": 1e-2}' --csv '%s' > /dev/null 2>&1",
+             prog, n_events[k], csv);
+    TEST_TRUE(app_run(cmd) == 0);
+    const int n = read_rows(csv, rows, 4);
+    TEST_TRUE(n == 2);
+    for (int i = 0; i < n && n == 2; i++) {
+      check_run(&rows[i], n_events[k]);
+      TEST_TRUE(rows[i].v[C_STEPS] == 2 * n_events[k] + 1);
+    }
+    if (n == 2) dofs[k] = rows[0].v[C_DOFS1];
+  }
+  TEST_TRUE(dofs[0] == dofs[1]);
+  static const char *const names[1] = {"dick_bunny3"};
+  static const double events[1] = {8};
+  check_scenes(prog, work, "cutbench-dick-events-scenes",
+               "--rows dick-bunny3 --dick-events 8 --scale 0.1 --surface-triangles 2000", names,
+               events, 1);
+}
+
 static void rows_mode(const char *prog, const char *work)
 {
   char cmd[8192], csv[1024];
@@ -266,6 +305,7 @@ static void rows_mode(const char *prog, const char *work)
                "--rows koschier-plate,tonthat-accordion,tonthat-octopus --scale 0.1 "
                "--surface-triangles 2000",
                names, events, 3);
+  dick_events(prog, work);
 }
 
 static void full(const char *prog, const char *work)
