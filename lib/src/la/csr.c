@@ -142,7 +142,7 @@ fcm_status fcm__csr_adopt_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols
   A->row_ptr = A->own_row_ptr = *row_ptr;
   A->col_idx = A->own_col_idx = *col_idx;
   *row_ptr = NULL, *col_idx = NULL;
-  FCM__ALLOC_WITH(fcm__calloc_large, ctx, A->nnz, A->values);
+  FCM__ALLOC_WITH(fcm__malloc_large, ctx, A->nnz, A->values);
   *out = A;
   A = NULL;
 cleanup:

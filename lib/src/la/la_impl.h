@@ -153,7 +153,8 @@ fcm_status fcm__csr_share_pattern_keep(fcm_ctx *ctx, fcm_index nrows, fcm_index 
                                        fcm_csr_kind kind, fcm_csr *give, fcm_csr **A, int *taken);
 
 /* A matrix that takes over *row_ptr and *col_idx (arrays from fcm__calloc or fcm__malloc;
- * set to NULL, also on failure, when they are freed), values zero. For patterns built inside
+ * set to NULL, also on failure, when they are freed), its values not set: the caller writes
+ * every one before any is read (no zero fill of a large array). For patterns built inside
  * the library that are already known to be valid (rows strictly increasing, in range, both
  * triangles of an FCM_CSR_SYMMETRIC pattern): unlike fcm_csr_create() it neither copies nor
  * checks them. (csr.c) */
@@ -164,7 +165,7 @@ fcm_status fcm__csr_adopt_pattern(fcm_ctx *ctx, fcm_index nrows, fcm_index ncols
 /* The sparse triple product C = P^T A P of a square matrix A (n x n, either kind) and a
  * prolongation P (n x nc, CSR arrays: P_ptr n + 1 offsets, P_col sorted per row in [0, nc),
  * P_val), like PETSc's MatPtAP, in two phases: fcm__ptap_create() finds the patterns of A P and
- * of C once and creates C (nc x nc, A's kind, values zero); fcm__ptap_apply() computes C's
+ * of C once and creates C (nc x nc, A's kind, values not yet set); fcm__ptap_apply() computes C's
  * values from A's current ones, as often as they change (same pattern). C = R (A P) with
  * R = P^T stored: each entry is summed by one thread in a fixed order (the rows of A, then of
  * P), so C does not depend on the thread count, but rounding may leave c_ij != c_ji for a
