@@ -3,9 +3,10 @@
  * sequence of three, the one fcm_mg_create() builds on the new space and matrix bit for bit
  * (every level's pattern, values and inactive rows, and two cycles, memcmp); each coarse
  * pattern is the structural pattern of P^T A P with the diagonal (a dense table); most rows
- * were taken (the counts of fcm__mg_get_kept()). The cut spaces take the old space's pattern
- * (fcm__space_create_cut_take()) and the old level-0 matrix is gone before the carry, as in an
- * integrator's cut. Before each cut, a carry whose allocations fail (several places) returns
+ * were taken (the counts of fcm__mg_get_kept()), and the coarsest analysis took the old
+ * ordering exactly where the coarsest pattern is the old one's. The cut spaces take the old space's
+ * pattern (fcm__space_create_cut_take()) and the old level-0 matrix is gone before the carry, as in
+ * an integrator's cut. Before each cut, a carry whose allocations fail (several places) returns
  * FCM_ERR_ALLOC, leaks nothing and leaves the old hierarchy as it was (its cycles' bits). A
  * carry whose preconditions fail (the old hierarchy made on another space, or on a matrix
  * not of its space's pattern; the new matrix not of its space's pattern) takes nothing and
@@ -78,6 +79,9 @@ static fcm_mg *beside_carry(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *pr
   return bes;
 }
 
+/* Carries whose coarsest analysis took the old hierarchy's ordering. */
+static int orderings_taken;
+
 /* The hierarchy carried from old (NULL: none; on prev's space) to p's pattern, then set up,
  * against fcm_mg_create() and the reference pattern; *pattern: its level-0 matrix. */
 static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *prev,
@@ -137,16 +141,23 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
   fcm__mg_kept k;
   fcm__mg_get_kept(prep, &k);
   if (getenv("FCM_TEST_VERBOSE"))
-    printf(
-        "%s: %d levels, %lld DOFs; plans carried %d, rows of A P taken %lld of %lld, coarse "
-        "rows %lld of %lld, blocks' positions copied %lld (level 0 has %lld); %s fcm_mg_create(), "
-        "structure %s the references\n",
-        what, fcm_mg_num_levels(prep), (long long)p->n, k.carried_plans,
-        (long long)k.carried_ap_rows, (long long)(coarse_rows - prep->lev[prep->nlev - 1].n + p->n),
-        (long long)k.carried_coarse_rows, (long long)coarse_rows, (long long)k.carried_blocks,
-        (long long)fcm__schwarz_num_blocks(prep->lev[0].blk), same ? "equals" : "DIFFERS from",
-        exact ? "equals" : "DIFFERS from");
+    printf("%s: %d levels, %lld DOFs; plans carried %d, rows of A P taken %lld of %lld, coarse "
+           "rows %lld of %lld, blocks' positions copied %lld (level 0 has %lld), coarsest "
+           "ordering %s; %s fcm_mg_create(), structure %s the references\n",
+           what, fcm_mg_num_levels(prep), (long long)p->n, k.carried_plans,
+           (long long)k.carried_ap_rows,
+           (long long)(coarse_rows - prep->lev[prep->nlev - 1].n + p->n),
+           (long long)k.carried_coarse_rows, (long long)coarse_rows, (long long)k.carried_blocks,
+           (long long)fcm__schwarz_num_blocks(prep->lev[0].blk),
+           k.carried_ordering ? "taken" : "found", same ? "equals" : "DIFFERS from",
+           exact ? "equals" : "DIFFERS from");
   TEST_TRUE(fcm_mg_num_levels(prep) >= 3);
+  { /* the coarsest analysis took the old ordering exactly where the coarsest patterns agree */
+    const int lc = prep->nlev - 1;
+    const int same_coarsest = old && old->nlev == prep->nlev && fcm__mg_level_same(old, prep, lc);
+    TEST_TRUE(k.carried_ordering == same_coarsest);
+    orderings_taken += k.carried_ordering;
+  }
   TEST_TRUE(same);
   TEST_TRUE(exact);
   if (old) { /* rows taken on every level both have (the body is small: a cut reaches much) */
@@ -434,6 +445,7 @@ int main(void)
   TEST_OK(ctx, fcm_ctx_create(NULL, &ctx));
   cut_sequence(ctx, FCM_ELEMENT_HEX8);
   cut_sequence(ctx, FCM_ELEMENT_HEX20);
+  TEST_TRUE(orderings_taken >= 2); /* the first cut of each element keeps the coarsest pattern */
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

@@ -302,6 +302,45 @@ cleanup:
   return st;
 }
 
+/* The coarsest level's solver and symbolic analysis. A cut whose coarsest pattern is that of
+ * the hierarchy before it (carry->old, read only) gives the analysis the old one's ordering,
+ * so that CHOLMOD skips its AMD and METIS orderings: on the same pattern they find that
+ * ordering again, which is postordered already. The ordering the analysis ends with is
+ * compared with the one it was given; where they differ, the analysis is made again without
+ * it, so that the factor is a plain creation's bit for bit either way. */
+static fcm_status coarsest_analysis(fcm_mg *m, const mg_carry *carry)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const int lc = m->nlev - 1;
+  const fcm_csr *A = fcm__mg_level_matrix(&m->lev[lc]);
+  const fcm_index n = m->lev[lc].n;
+  const fcm_mg *old = carry ? carry->old : NULL;
+  fcm_index *perm = NULL;
+  const int given = old && lc > 0 && n > 0 && old->nlev == m->nlev && old->direct &&
+                    fcm__mg_level_same(old, m, lc);
+  FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &m->direct));
+  if (given) {
+    FCM_ALLOC_RAW(ctx, 2 * (size_t)n, perm);
+    FCM_TRY(ctx, fcm__direct_get_ordering(old->direct, perm));
+    FCM_TRY(ctx, fcm__direct_set_ordering(m->direct, perm));
+  }
+  FCM_TRY(ctx, fcm_direct_analyze(m->direct));
+  if (given) {
+    FCM_TRY(ctx, fcm__direct_get_ordering(m->direct, perm + n));
+    if (memcmp(perm, perm + n, sizeof *perm * (size_t)n) == 0) {
+      m->kept.carried_ordering = 1;
+    } else {
+      fcm_direct_destroy(&m->direct);
+      FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &m->direct));
+      FCM_TRY(ctx, fcm_direct_analyze(m->direct));
+    }
+  }
+cleanup:
+  fcm__free(ctx, perm);
+  return st;
+}
+
 /* The levels' Galerkin plans and patterns, the row orders of the levels from `first` on and
  * the coarsest analysis (keeping old's where fcm__mg_create_from() may; same[l]: level l's
  * pattern is old's). */
@@ -328,9 +367,7 @@ static fcm_status create_patterns(fcm_mg *m, fcm_mg *old, mg_carry *carry, unsig
     FCM_TRY(ctx, level_orders(m, &m->lev[l]));
   if (!(old && fcm__mg_keep_analysis(old, m, same[m->nlev - 1]))) {
     if (old) fcm_direct_destroy(&old->direct); /* not taken: freed first, as above */
-    mg_level *Lc = &m->lev[m->nlev - 1];
-    FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, fcm__mg_level_matrix(Lc), &m->direct));
-    FCM_TRY(ctx, fcm_direct_analyze(m->direct));
+    FCM_TRY(ctx, coarsest_analysis(m, carry));
   }
 cleanup:
   return st;

@@ -84,6 +84,8 @@ typedef struct fcm__mg_kept {
   int carried_plans;
   fcm_index carried_ap_rows, carried_coarse_rows;
   fcm_index carried_blocks; /* blocks whose positions were copied, all levels */
+  int carried_ordering;     /* 1: the coarsest analysis took the old one's ordering (the
+                               coarsest pattern the old one's) */
 } fcm__mg_kept;
 
 /* fcm_mg_create(ctx, space, A, opts, mg), taking from *old (NULL or *old == NULL: nothing)
