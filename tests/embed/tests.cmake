@@ -113,7 +113,8 @@ fcm_add_test(embed_cut_surface_quadratic tests/embed/cut_surface.c ARGS quadrati
 # A sheet of many nearly coplanar triangles (warped by 1/275 of a cell) across a ball given as
 # tets and as its boundary: no degenerate cell, every cell as many pieces as under the flat
 # sheet, piece volumes within the warp's (5e-3 of a cell), the body's volume kept (1e-12).
-fcm_add_test(embed_cut_warped tests/embed/cut_warped.c)
+# About 90 s in a release build; the sanitizer build (Debug, ASan + UBSan) takes about 7 min.
+fcm_add_test(embed_cut_warped tests/embed/cut_warped.c TIMEOUT 900)
 # A cutting scene on a surface file: no Gmsh phase, the same DOFs and centre of mass (1e-12) as
 # the volume path, the largest displacement within 1 %.
 fcm_add_test(embed_cut_surface_scene tests/embed/cut_surface_scene.c)

@@ -376,9 +376,11 @@ void fcm__free(fcm_ctx *ctx, void *ptr)
 fcm_status fcm__resize(fcm_ctx *ctx, void **ptr, size_t old_n, size_t new_n, size_t size)
 {
   fcm_status st = FCM_OK;
-  unsigned char *fresh = fcm__calloc(ctx, new_n, size);
+  unsigned char *fresh = fcm__malloc(ctx, new_n, size);
   FCM_CHECK(fresh, ctx, FCM_ERR_ALLOC, "out of memory resizing an array to %zu elements", new_n);
-  if (*ptr) memcpy(fresh, *ptr, FCM_MIN(old_n, new_n) * size);
+  const size_t kept = *ptr ? FCM_MIN(old_n, new_n) : 0; /* copied, the rest zeroed */
+  if (kept) memcpy(fresh, *ptr, kept * size);
+  memset(fresh + kept * size, 0, (new_n - kept) * size);
   fcm__free(ctx, *ptr);
   *ptr = fresh;
 cleanup:

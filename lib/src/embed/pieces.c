@@ -59,7 +59,21 @@ void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P)
   P->n = P->cap = P->nfx = P->capfx = P->nfp = P->capfp = P->ufcap = 0;
 }
 
-/* Room for `need` parts. */
+/* Copy the used part of a polyhedron (the struct is ~26 kB, mostly unused). */
+static void poly_copy(fcm__poly *dst, const fcm__poly *src)
+{
+  dst->nv = src->nv, dst->nf = src->nf;
+  memcpy(dst->x, src->x, (size_t)src->nv * sizeof src->x[0]);
+  for (int f = 0; f < src->nf; f++) {
+    dst->fn[f] = src->fn[f];
+    memcpy(dst->fv[f], src->fv[f], (size_t)src->fn[f] * sizeof src->fv[f][0]);
+  }
+  memcpy(dst->fp, src->fp, (size_t)src->nf * sizeof src->fp[0]);
+}
+
+/* Room for `need` parts. The polyhedra are read only up to their counts (every slot is
+ * written by poly_copy() before it is read): the new array is neither zeroed nor filled
+ * beyond the used part of the P->n there are, a fraction of the 26 kB each. */
 static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
 {
   fcm_status st = FCM_OK;
@@ -67,8 +81,12 @@ static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
   size_t cap = P->cap ? 2 * P->cap : 16;
   while (cap < need)
     cap *= 2;
-  void *p = P->poly, *t = P->tol, *v = P->vmin, *q = P->piece, *r = P->parent;
-  FCM_TRY(ctx, fcm__resize(ctx, &p, P->n, cap, sizeof(fcm__poly)));
+  void *t = P->tol, *v = P->vmin, *q = P->piece, *r = P->parent;
+  fcm__poly *p = fcm__malloc(ctx, cap, sizeof *p);
+  FCM_CHECK(p, ctx, FCM_ERR_ALLOC, "cell parts: out of memory for %zu polyhedra", cap);
+  for (size_t i = 0; i < P->n; i++)
+    poly_copy(p + i, P->poly + i);
+  fcm__free(ctx, P->poly);
   P->poly = p;
   FCM_TRY(ctx, fcm__resize(ctx, &t, P->n, cap, sizeof(double)));
   P->tol = t;
@@ -84,18 +102,6 @@ static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
   P->cap = cap;
 cleanup:
   return st;
-}
-
-/* Copy the used part of a polyhedron (the struct is ~26 kB, mostly unused). */
-static void poly_copy(fcm__poly *dst, const fcm__poly *src)
-{
-  dst->nv = src->nv, dst->nf = src->nf;
-  memcpy(dst->x, src->x, (size_t)src->nv * sizeof src->x[0]);
-  for (int f = 0; f < src->nf; f++) {
-    dst->fn[f] = src->fn[f];
-    memcpy(dst->fv[f], src->fv[f], (size_t)src->fn[f] * sizeof src->fv[f][0]);
-  }
-  memcpy(dst->fp, src->fp, (size_t)src->nf * sizeof src->fp[0]);
 }
 
 fcm_status fcm__embed_parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const fcm__poly *q,
