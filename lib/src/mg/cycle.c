@@ -109,6 +109,9 @@ fcm_status fcm_mg_cycle(fcm_mg *m, const double *b, double *x)
   FCM_CHECK(!m->setup_failed, ctx, FCM_ERR_ARG,
             "mg_cycle: the last fcm_mg_setup() failed, so the levels' values are not one set: "
             "set the hierarchy up again");
+  FCM_CHECK(!m->values_pending, ctx, FCM_ERR_ARG,
+            "mg_cycle: the hierarchy was created on a pattern and has no values yet: call "
+            "fcm_mg_setup() first");
   FCM_TRY(ctx, cycle(m, 0, b, x));
 cleanup:
   return st;
@@ -194,6 +197,9 @@ fcm_status fcm_mg_solve(fcm_mg *m, const double *b, double *x, double rtol, int 
   FCM_CHECK(!m->setup_failed, ctx, FCM_ERR_ARG,
             "mg_solve: the last fcm_mg_setup() failed, so the levels' values are not one set: "
             "set the hierarchy up again");
+  FCM_CHECK(!m->values_pending, ctx, FCM_ERR_ARG,
+            "mg_solve: the hierarchy was created on a pattern and has no values yet: call "
+            "fcm_mg_setup() first");
   mg_level *L = &m->lev[0];
   const fcm_index n = L->n;
   const double bn = norm2(n, b);
