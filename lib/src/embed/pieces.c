@@ -59,20 +59,8 @@ void fcm__embed_parts_free(fcm_ctx *ctx, fcm__parts *P)
   P->n = P->cap = P->nfx = P->capfx = P->nfp = P->capfp = P->ufcap = 0;
 }
 
-/* Copy the used part of a polyhedron (the struct is ~26 kB, mostly unused). */
-static void poly_copy(fcm__poly *dst, const fcm__poly *src)
-{
-  dst->nv = src->nv, dst->nf = src->nf;
-  memcpy(dst->x, src->x, (size_t)src->nv * sizeof src->x[0]);
-  for (int f = 0; f < src->nf; f++) {
-    dst->fn[f] = src->fn[f];
-    memcpy(dst->fv[f], src->fv[f], (size_t)src->fn[f] * sizeof src->fv[f][0]);
-  }
-  memcpy(dst->fp, src->fp, (size_t)src->nf * sizeof src->fp[0]);
-}
-
 /* Room for `need` parts. The polyhedra are read only up to their counts (every slot is
- * written by poly_copy() before it is read): the new array is neither zeroed nor filled
+ * written by fcm__geom_poly_copy() before it is read): the new array is neither zeroed nor filled
  * beyond the used part of the P->n there are, a fraction of the 26 kB each. */
 static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
 {
@@ -85,7 +73,7 @@ static fcm_status parts_grow(fcm_ctx *ctx, fcm__parts *P, size_t need)
   fcm__poly *p = fcm__malloc(ctx, cap, sizeof *p);
   FCM_CHECK(p, ctx, FCM_ERR_ALLOC, "cell parts: out of memory for %zu polyhedra", cap);
   for (size_t i = 0; i < P->n; i++)
-    poly_copy(p + i, P->poly + i);
+    fcm__geom_poly_copy(p + i, P->poly + i);
   fcm__free(ctx, P->poly);
   P->poly = p;
   FCM_TRY(ctx, fcm__resize(ctx, &t, P->n, cap, sizeof(double)));
@@ -112,7 +100,7 @@ fcm_status fcm__embed_parts_put(fcm_ctx *ctx, fcm__parts *P, size_t slot, const 
     FCM_TRY(ctx, parts_grow(ctx, P, P->n + 1));
     P->n++;
   }
-  poly_copy(P->poly + slot, q);
+  fcm__geom_poly_copy(P->poly + slot, q);
   P->tol[slot] = tol;
   P->vmin[slot] = vmin;
   P->piece[slot] = 0;
@@ -204,7 +192,7 @@ fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, cons
   P->whole = 0;
   const double full = P->mat && fcm__embed_part_full(P, i) ? -1.0 : 0.0; /* the pieces' too */
   fcm__poly *W = P->w; /* W[0]: the part in the column; W[1]: one side; W[2]: outside an edge */
-  poly_copy(&W[0], P->poly + i);
+  fcm__geom_poly_copy(&W[0], P->poly + i);
   size_t slot = i;
   int overflow = 0;
   /* outside the triangle's column the plane is no cut: what lies there is left whole (split
@@ -217,7 +205,7 @@ fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, cons
     plane_range(&W[0], &t->edge[e], &lo, &hi);
     const int flat = lo >= -tol && hi <= tol;
     if (flat && t->owns[e]) continue;
-    poly_copy(&W[2], &W[0]);
+    fcm__geom_poly_copy(&W[2], &W[0]);
     if (flat) {
       W[0].nv = W[0].nf = 0;
     } else {
@@ -234,7 +222,7 @@ fcm_status fcm__embed_part_split(fcm_ctx *ctx, const fcm__embed_cell *cell, cons
   plane_range(&W[0], &t->plane, &lo, &hi);
   const int flat = lo >= -tol && hi <= tol; /* one part, the flat one the links treat as such */
   for (int side = 0; side < 2 - flat && W[0].nf > 0; side++) {
-    poly_copy(&W[1], &W[0]);
+    fcm__geom_poly_copy(&W[1], &W[0]);
     const fcm__plane h = side ? flip(&t->plane) : t->plane;
     if (!flat) overflow |= fcm__geom_poly_clip(&W[1], &h, tol, &P->scratch);
     if (W[1].nf > 0) {
@@ -484,7 +472,7 @@ void fcm__embed_parts_compact(fcm__parts *P)
   for (size_t i = 0; i < P->n; i++) {
     if (P->poly[i].nf == 0) continue;
     if (kept != i) {
-      poly_copy(P->poly + kept, P->poly + i);
+      fcm__geom_poly_copy(P->poly + kept, P->poly + i);
       P->tol[kept] = P->tol[i];
       P->vmin[kept] = P->vmin[i];
       P->parent[kept] = P->parent[i];

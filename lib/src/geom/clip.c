@@ -225,6 +225,17 @@ static int store_cap(fcm__poly *out, const fcm__plane *pl, int *ids, int k,
   return 0;
 }
 
+void fcm__geom_poly_copy(fcm__poly *dst, const fcm__poly *src)
+{
+  dst->nv = src->nv, dst->nf = src->nf;
+  memcpy(dst->x, src->x, (size_t)src->nv * sizeof src->x[0]);
+  for (int f = 0; f < src->nf; f++) {
+    dst->fn[f] = src->fn[f];
+    memcpy(dst->fv[f], src->fv[f], (size_t)src->fn[f] * sizeof src->fv[f][0]);
+  }
+  memcpy(dst->fp, src->fp, (size_t)src->nf * sizeof src->fp[0]);
+}
+
 int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__poly *out)
 {
   double s[FCM__POLY_MAX_VERTS];
@@ -312,14 +323,7 @@ int fcm__geom_poly_clip(fcm__poly *p, const fcm__plane *pl, double tol, fcm__pol
     }
   }
   if (out->nf < 4) out->nv = out->nf = 0; /* fewer than 4 faces: no volume */
-  /* Copy back only the used parts (the struct is ~26 kB). */
-  p->nv = out->nv, p->nf = out->nf;
-  memcpy(p->x, out->x, (size_t)out->nv * sizeof out->x[0]);
-  for (int f = 0; f < out->nf; f++) {
-    p->fn[f] = out->fn[f];
-    memcpy(p->fv[f], out->fv[f], (size_t)out->fn[f] * sizeof out->fv[f][0]);
-  }
-  memcpy(p->fp, out->fp, (size_t)out->nf * sizeof out->fp[0]);
+  fcm__geom_poly_copy(p, out);
   return 0;
 overflow:
   p->nv = p->nf = 0;

@@ -166,6 +166,10 @@ void fcm__geom_poly_from_cell_shape(fcm_element_type type, const double *X, fcm_
  * a degenerate face (zero normal) gets n = 0, d = 0 (never clips). */
 int fcm__geom_cell_planes(const fcm_element_info *info, const double *X, fcm__plane *planes);
 
+/* Copy the used part of src into dst (counts, vertices, faces and planes up to the counts;
+ * the struct is ~26 kB, mostly unused): what a polyhedron's readers read. */
+void fcm__geom_poly_copy(fcm__poly *dst, const fcm__poly *src);
+
 /* Clip p by the half-space `pl` in place. Each vertex is classified once against
  * the plane: outside when n.x - d > tol, inside when < -tol, on the plane otherwise;
  * on-plane vertices are kept where they are and new vertices are made only on edges
