@@ -14,6 +14,8 @@ fcm_add_test(la_direct tests/la/direct.c)
 fcm_add_test(la_alloc_failure tests/la/alloc_failure.c)
 # The sparse triple product P^T A P against a dense product, 1 and 2 threads.
 fcm_add_test(la_ptap tests/la/ptap.c)
+# The grouped AMD ordering (a node's DOFs together) against CHOLMOD's own orderings.
+fcm_add_test(la_ordering tests/la/ordering.c)
 # The BLAS kernel query and its once-per-context warning: with the kernels OpenBLAS (or the
 # test environment) chose, and with the SSE3 fallback forced, which every AVX CPU must flag.
 fcm_add_test(la_blas_info tests/la/blas_info.c)

@@ -287,4 +287,15 @@ fcm_status fcm__direct_set_ordering(fcm_direct *s, const fcm_index *perm);
 fcm_status fcm__direct_get_ordering(const fcm_direct *s, fcm_index *perm);
 extern const fcm__direct_ops fcm__umfpack_ops;
 
+/* A fill-reducing ordering of the symmetric pattern A whose rows come in groups (group[i] in
+ * [0, ngroup): row i's, e.g. its node): AMD on the graph of the groups (two neighbour when a
+ * row of one has an entry in a column of the other), each group's rows then together in
+ * ascending order; n entries into perm (perm[k]: the row eliminated k-th), for
+ * fcm__direct_set_ordering(). On the DOFs of 3-D elasticity the graph has a ninth of A's
+ * entries, so it is found several times faster than AMD on A, with a factor of about AMD's
+ * size. @return FCM_OK, FCM_ERR_ARG (a group outside the range), FCM_ERR_ALLOC,
+ * FCM_ERR_INTERNAL (AMD refused the graph). (ordering.c) */
+fcm_status fcm__amd_group_ordering(fcm_ctx *ctx, const fcm_csr *A, fcm_index ngroup,
+                                   const fcm_index *group, fcm_index *perm);
+
 #endif /* FCM_LA_IMPL_H */

@@ -302,12 +302,44 @@ cleanup:
   return st;
 }
 
+/* The largest coarsest level ordered by coarsest_node_ordering(): five times the default
+ * coarse_dofs. Above, the factor's size (each set-up factors it again) outweighs the ordering's
+ * time, and CHOLMOD's best of AMD and METIS is kept. */
+enum { NODE_ORDER_MAX = 10000 };
+
+/* The coarsest level's ordering where it is small (at most NODE_ORDER_MAX DOFs):
+ * AMD on the graph of its copies (a copy's DOFs together), given to the analysis in place of
+ * CHOLMOD's own AMD and METIS on the DOFs (lib/docs/cutting.md, "The coarsest ordering").
+ * None where the level is larger, or a DOF is in no copy: CHOLMOD orders it then. perm: room
+ * for the level's n DOFs. */
+static fcm_status coarsest_node_ordering(fcm_mg *m, const fcm_csr *A, fcm_index *perm)
+{
+  fcm_status st = FCM_OK;
+  fcm_ctx *ctx = m->ctx;
+  const mg_level *L = &m->lev[m->nlev - 1];
+  fcm_index *group = NULL;
+  if (L->n > NODE_ORDER_MAX || !L->dof) goto cleanup;
+  FCM_ALLOC_RAW(ctx, (size_t)L->n, group);
+  for (fcm_index i = 0; i < L->n; i++)
+    group[i] = -1;
+  for (fcm_index k = 0; k < L->ncopy; k++)
+    for (int c = 0; c < 3; c++)
+      if (L->dof[3 * k + c] >= 0) group[L->dof[3 * k + c]] = k;
+  for (fcm_index i = 0; i < L->n; i++)
+    if (group[i] < 0) goto cleanup;
+  FCM_TRY(ctx, fcm__amd_group_ordering(ctx, A, L->ncopy, group, perm));
+  FCM_TRY(ctx, fcm__direct_set_ordering(m->direct, perm));
+cleanup:
+  fcm__free(ctx, group);
+  return st;
+}
+
 /* The coarsest level's solver and symbolic analysis. A cut whose coarsest pattern is that of
  * the hierarchy before it (carry->old, read only) gives the analysis the old one's ordering,
- * so that CHOLMOD skips its AMD and METIS orderings: on the same pattern they find that
- * ordering again, which is postordered already. The ordering the analysis ends with is
- * compared with the one it was given; where they differ, the analysis is made again without
- * it, so that the factor is a plain creation's bit for bit either way. */
+ * so that CHOLMOD only postorders it: on the same pattern the ordering would be found again,
+ * postordered already. The ordering the analysis ends with is compared with the one it was
+ * given; where they differ, the analysis is made again without it, so that the factor is a
+ * plain creation's bit for bit either way. */
 static fcm_status coarsest_analysis(fcm_mg *m, const mg_carry *carry)
 {
   fcm_status st = FCM_OK;
@@ -319,11 +351,13 @@ static fcm_status coarsest_analysis(fcm_mg *m, const mg_carry *carry)
   fcm_index *perm = NULL;
   const int given = old && lc > 0 && n > 0 && old->nlev == m->nlev && old->direct &&
                     fcm__mg_level_same(old, m, lc);
+  FCM_ALLOC_RAW(ctx, 2 * (size_t)n + 1, perm);
   FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &m->direct));
   if (given) {
-    FCM_ALLOC_RAW(ctx, 2 * (size_t)n, perm);
     FCM_TRY(ctx, fcm__direct_get_ordering(old->direct, perm));
     FCM_TRY(ctx, fcm__direct_set_ordering(m->direct, perm));
+  } else {
+    FCM_TRY(ctx, coarsest_node_ordering(m, A, perm));
   }
   FCM_TRY(ctx, fcm_direct_analyze(m->direct));
   if (given) {
@@ -333,6 +367,7 @@ static fcm_status coarsest_analysis(fcm_mg *m, const mg_carry *carry)
     } else {
       fcm_direct_destroy(&m->direct);
       FCM_TRY(ctx, fcm_direct_create(ctx, FCM_DIRECT_CHOLMOD, A, &m->direct));
+      FCM_TRY(ctx, coarsest_node_ordering(m, A, perm));
       FCM_TRY(ctx, fcm_direct_analyze(m->direct));
     }
   }
