@@ -1,5 +1,6 @@
-/* apps: process environment of the fcm programs — passive OpenMP waiting and the CPU's
- * OpenBLAS kernels by default, by re-executing the program once (see app_env.h). */
+/* apps: process environment of the fcm programs — passive OpenMP waiting, the CPU's OpenBLAS
+ * kernels and malloc's memory on huge pages by default, by re-executing the program once (see
+ * app_env.h). */
 #if !defined(_POSIX_C_SOURCE) || _POSIX_C_SOURCE < 200809L
 #undef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L /* setenv */
@@ -16,6 +17,10 @@
 
 /* Set in the re-executed program: the kernels OpenBLAS had chosen before the selection. */
 #define NOTE_VAR "FCM_BLAS_CORETYPE_REPLACED"
+
+/* glibc's malloc (2.35 and later; others ignore it): its heap and its mapped blocks advised
+ * for transparent huge pages (app_env.h) */
+#define MALLOC_TUNABLES "glibc.malloc.hugetlb=1"
 
 static const char *base_name(const char *path)
 {
@@ -64,16 +69,18 @@ static void init(int argc, char **argv, int omp)
   /* the user's choice wins */
   const int set_omp =
       omp && !getenv("OMP_WAIT_POLICY") && !getenv("GOMP_SPINCOUNT") && !getenv("KMP_BLOCKTIME");
+  const int set_malloc = omp && !getenv("GLIBC_TUNABLES");
   fcm_blas_info b;
   const char *core = blas_core_to_select(prog, &b);
-  if (!set_omp && !core) return;
+  if (!set_omp && !set_malloc && !core) return;
 #ifdef __linux__
   if (set_omp && setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+  if (set_malloc && setenv("GLIBC_TUNABLES", MALLOC_TUNABLES, 1) != 0) return;
   if (core && (setenv("OPENBLAS_CORETYPE", core, 1) != 0 || setenv(NOTE_VAR, b.core, 1) != 0))
     return;
   execv("/proc/self/exe", argv);
   /* exec failed (no /proc?): go on as started; the variables stay set, so a child process of
-   * ours would wait passively and use the selected kernels */
+   * ours would wait passively, use the selected kernels and huge pages */
   unsetenv(NOTE_VAR);
 #endif
 }

@@ -19,7 +19,15 @@
  * CPU's kernels with OPENBLAS_CORETYPE and say so in one line on stderr;
  * FCM_BLAS_CORETYPE=keep keeps the kernels OpenBLAS chose.
  *
- * Both runtimes read their environment when they are loaded, before main(), so setting the
+ * Memory the program touches for the first time costs a page fault per 4 KiB page, and on
+ * virtual machines a fault can cost ten times the page's zero fill (12 us measured; faults
+ * took a sixth of the time of Dick's Bunny 3 row in fcm-cutbench). Unless the user has set
+ * GLIBC_TUNABLES (an empty value keeps glibc's defaults), the programs run with
+ * glibc.malloc.hugetlb=1: malloc advises its heap and its mapped blocks for transparent huge pages
+ * (where the kernel offers them on request), so that they fault in 2 MiB at a time
+ * (lib/docs/performance.md, "Page faults").
+ *
+ * The runtimes read their environment when they are loaded, before main(), so setting the
  * variables here would come too late (and a .preinit_array function cannot set them either:
  * glibc installs the environment after it). Instead this sets them and re-executes the
  * program once (/proc/self/exe, same arguments, Linux only); the new process finds them set
@@ -28,8 +36,8 @@
  * continues as it started. Returns only when no re-execution took place. */
 void app_env_init(int argc, char **argv);
 
-/** app_env_init() for the BLAS kernels only, leaving the OpenMP wait policy as the program
- * was started with (benchmarks that measure the policies themselves). */
+/** app_env_init() for the BLAS kernels only, leaving the OpenMP wait policy and malloc as the
+ * program was started with (benchmarks that measure the policies themselves). */
 void app_env_init_blas(int argc, char **argv);
 
 #endif /* FCM_APP_ENV_H */

@@ -9,7 +9,10 @@
  * and the runtime spins 0 times; with OMP_WAIT_POLICY or GOMP_SPINCOUNT set by the user, it
  * runs once and the user's values are in effect; under the SSE3 kernels on a CPU with AVX or
  * more, it runs twice with OPENBLAS_CORETYPE = the CPU's kernel set and says so in one line
- * on stderr; OPENBLAS_CORETYPE set by the user or FCM_BLAS_CORETYPE=keep: one run, no note. */
+ * on stderr; OPENBLAS_CORETYPE set by the user or FCM_BLAS_CORETYPE=keep: one run, no note.
+ * With GLIBC_TUNABLES unset it runs twice with glibc.malloc.hugetlb=1 in it (alone, or with
+ * the other changes in one re-execution); set by the user, even empty, it is kept. The other
+ * cases run with GLIBC_TUNABLES empty (glibc's defaults kept). */
 #define _POSIX_C_SOURCE 200809L
 #include "../../apps/app_env.h"
 #include "test.h"
@@ -28,8 +31,12 @@ static int probe(int argc, char **argv)
   snprintf(buf, sizeof buf, "%d", (r ? atoi(r) : 0) + 1);
   setenv(RUNS_VAR, buf, 1);
   app_env_init(argc, argv);
-  const char *p = getenv("OMP_WAIT_POLICY"), *c = getenv("OPENBLAS_CORETYPE");
-  printf("runs=%s policy=%s coretype=%s\n", getenv(RUNS_VAR), p ? p : "-", c ? c : "-");
+  const char *p = getenv("OMP_WAIT_POLICY"), *c = getenv("OPENBLAS_CORETYPE"),
+             *t = getenv("GLIBC_TUNABLES");
+  printf("runs=%s policy=%s coretype=%s tunables=%s\n", getenv(RUNS_VAR), p ? p : "-", c ? c : "-",
+         !t     ? "-"
+         : t[0] ? t
+                : "(empty)");
   fflush(stdout);
   omp_display_env(1); /* to stderr */
   return 0;
@@ -41,6 +48,8 @@ typedef struct probe_env {
   const char *coretype;      /* OPENBLAS_CORETYPE */
   const char *mode;          /* FCM_BLAS_CORETYPE */
   const char *preload;       /* LD_PRELOAD */
+  const char *tunables;      /* GLIBC_TUNABLES: NULL empty (glibc's defaults kept) */
+  int no_tunables;           /* GLIBC_TUNABLES unset */
 } probe_env;
 
 /* What a probe run reported. */
@@ -49,6 +58,7 @@ typedef struct probe_out {
   long long spincount; /* the runtime's GOMP_SPINCOUNT (-1 when not reported) */
   char policy[64];     /* OMP_WAIT_POLICY in its environment, "-" unset */
   char coretype[64];   /* OPENBLAS_CORETYPE in its environment, "-" unset */
+  char tunables[256];  /* GLIBC_TUNABLES in its environment, "-" unset, "(empty)" */
   int blas_notes;      /* lines on stderr saying which kernels were selected */
   char blas_note[512]; /* the last one */
 } probe_out;
@@ -76,6 +86,7 @@ static void run(const char *self, const char *dir, probe_env e, probe_out *o)
     set_or_unset("OPENBLAS_CORETYPE", e.coretype);
     set_or_unset("FCM_BLAS_CORETYPE", e.mode);
     set_or_unset("LD_PRELOAD", e.preload);
+    set_or_unset("GLIBC_TUNABLES", e.no_tunables ? NULL : e.tunables ? e.tunables : "");
     if (!freopen(out, "w", stdout) || !freopen(err, "w", stderr)) _exit(127);
     execl(self, self, "probe", (char *)NULL);
     _exit(127);
@@ -87,8 +98,8 @@ static void run(const char *self, const char *dir, probe_env e, probe_out *o)
   o->runs = -1;
   o->spincount = -1;
   FILE *f = fopen(out, "r");
-  TEST_TRUE(f &&
-            fscanf(f, "runs=%d policy=%63s coretype=%63s", &o->runs, o->policy, o->coretype) == 3);
+  TEST_TRUE(f && fscanf(f, "runs=%d policy=%63s coretype=%63s tunables=%255s", &o->runs, o->policy,
+                        o->coretype, o->tunables) == 4);
   if (f) fclose(f);
   /* the last GOMP_SPINCOUNT line is the final process's */
   f = fopen(err, "r");
@@ -153,5 +164,19 @@ int main(int argc, char **argv)
   TEST_TRUE(o.runs == 1 && !strcmp(o.coretype, "Haswell") && o.blas_notes == 0);
   run(self, dir, (probe_env){.policy = "active", .mode = "keep", .preload = shim}, &o);
   TEST_TRUE(o.runs == 1 && !strcmp(o.coretype, "-") && o.blas_notes == 0);
+
+  /* malloc: GLIBC_TUNABLES unset gets huge pages, alone or in the one re-execution */
+  run(self, dir, (probe_env){.policy = "active", .mode = "keep", .no_tunables = 1}, &o);
+  TEST_TRUE(o.runs == 2 && !strcmp(o.tunables, "glibc.malloc.hugetlb=1") &&
+            !strcmp(o.policy, "active"));
+  run(self, dir, (probe_env){.mode = "keep", .no_tunables = 1}, &o);
+  TEST_TRUE(o.runs == 2 && !strcmp(o.tunables, "glibc.malloc.hugetlb=1") &&
+            !strcmp(o.policy, "passive"));
+  /* the user's tunables win, even empty */
+  run(self, dir,
+      (probe_env){.policy = "active", .mode = "keep", .tunables = "glibc.malloc.arena_max=2"}, &o);
+  TEST_TRUE(o.runs == 1 && !strcmp(o.tunables, "glibc.malloc.arena_max=2"));
+  run(self, dir, (probe_env){.policy = "active", .mode = "keep"}, &o);
+  TEST_TRUE(o.runs == 1 && !strcmp(o.tunables, "(empty)"));
   return TEST_RESULT();
 }
