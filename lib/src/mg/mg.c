@@ -302,10 +302,11 @@ cleanup:
   return st;
 }
 
-/* The largest coarsest level ordered by coarsest_node_ordering(): five times the default
- * coarse_dofs. Above, the factor's size (each set-up factors it again) outweighs the ordering's
- * time, and CHOLMOD's best of AMD and METIS is kept. */
-enum { NODE_ORDER_MAX = 10000 };
+/* The largest coarsest level ordered by coarsest_node_ordering(): twice the default
+ * coarse_dofs. Above, the factor's size (each set-up factors it again; METIS's can be a quarter
+ * smaller than AMD's) outweighs the ordering's time, and CHOLMOD's best of AMD and METIS is
+ * kept. */
+enum { NODE_ORDER_MAX = 4000 };
 
 /* The coarsest level's ordering where it is small (at most NODE_ORDER_MAX DOFs):
  * AMD on the graph of its copies (a copy's DOFs together), given to the analysis in place of
