@@ -19,9 +19,8 @@
  * CPU's kernels with OPENBLAS_CORETYPE and say so in one line on stderr;
  * FCM_BLAS_CORETYPE=keep keeps the kernels OpenBLAS chose.
  *
- * Memory the program touches for the first time costs a page fault per 4 KiB page, and on
- * virtual machines a fault can cost ten times the page's zero fill (12 us measured; faults
- * took a sixth of the time of Dick's Bunny 3 row in fcm-cutbench). Unless the user has set
+ * Memory the program touches for the first time costs a page fault per 4 KiB page, which on
+ * virtual machines can cost several times the page's zero fill. Unless the user has set
  * GLIBC_TUNABLES (an empty value keeps glibc's defaults), the programs run with
  * glibc.malloc.hugetlb=1: malloc advises its heap and its mapped blocks for transparent huge pages
  * (where the kernel offers them on request), so that they fault in 2 MiB at a time

@@ -292,8 +292,9 @@ extern const fcm__direct_ops fcm__umfpack_ops;
  * row of one has an entry in a column of the other), each group's rows then together in
  * ascending order; n entries into perm (perm[k]: the row eliminated k-th), for
  * fcm__direct_set_ordering(). On the DOFs of 3-D elasticity the graph has a ninth of A's
- * entries, so it is found several times faster than AMD on A, with a factor of about AMD's
- * size. @return FCM_OK, FCM_ERR_ARG (a group outside the range), FCM_ERR_ALLOC,
+ * entries, so it is found faster than AMD on A, with a factor of about AMD's size
+ * (lib/docs/cutting.md, "The coarsest ordering"). @return FCM_OK, FCM_ERR_ARG (NULL, ngroup
+ * < 0, A not square, a group outside [0, ngroup)), FCM_ERR_ALLOC,
  * FCM_ERR_INTERNAL (AMD refused the graph). (ordering.c) */
 fcm_status fcm__amd_group_ordering(fcm_ctx *ctx, const fcm_csr *A, fcm_index ngroup,
                                    const fcm_index *group, fcm_index *perm);

@@ -303,9 +303,9 @@ cleanup:
 }
 
 /* The largest coarsest level ordered by coarsest_node_ordering(): twice the default
- * coarse_dofs. Above, the factor's size (each set-up factors it again; METIS's can be a quarter
+ * coarse_dofs. Above, the factor's size (each set-up factors it again, and METIS's can be
  * smaller than AMD's) outweighs the ordering's time, and CHOLMOD's best of AMD and METIS is
- * kept. */
+ * kept (lib/docs/cutting.md, "The coarsest ordering"). */
 enum { NODE_ORDER_MAX = 4000 };
 
 /* The coarsest level's ordering where it is small (at most NODE_ORDER_MAX DOFs):
