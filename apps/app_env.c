@@ -1,6 +1,6 @@
-/* apps: process environment of the fcm programs — passive OpenMP waiting, the CPU's OpenBLAS
- * kernels and malloc's memory on huge pages by default, by re-executing the program once (see
- * app_env.h). */
+/* apps: process environment of the fcm programs — a short OpenMP spin before sleeping, the
+ * CPU's OpenBLAS kernels and malloc's memory on huge pages by default, by re-executing the
+ * program once (see app_env.h). */
 #if !defined(_POSIX_C_SOURCE) || _POSIX_C_SOURCE < 200809L
 #undef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L /* setenv */
@@ -21,6 +21,9 @@
 /* glibc's malloc (2.35 and later; others ignore it): its heap and its mapped blocks advised
  * for transparent huge pages (app_env.h) */
 #define MALLOC_TUNABLES "glibc.malloc.hugetlb=1"
+
+/* libgomp's polls of a waiting OpenMP thread before it sleeps (app_env.h) */
+#define SPINCOUNT "10000"
 
 static const char *base_name(const char *path)
 {
@@ -74,13 +77,13 @@ static void init(int argc, char **argv, int omp)
   const char *core = blas_core_to_select(prog, &b);
   if (!set_omp && !set_malloc && !core) return;
 #ifdef __linux__
-  if (set_omp && setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+  if (set_omp && setenv("GOMP_SPINCOUNT", SPINCOUNT, 1) != 0) return;
   if (set_malloc && setenv("GLIBC_TUNABLES", MALLOC_TUNABLES, 1) != 0) return;
   if (core && (setenv("OPENBLAS_CORETYPE", core, 1) != 0 || setenv(NOTE_VAR, b.core, 1) != 0))
     return;
   execv("/proc/self/exe", argv);
   /* exec failed (no /proc?): go on as started; the variables stay set, so a child process of
-   * ours would wait passively, use the selected kernels and huge pages */
+   * ours would spin briefly, use the selected kernels and huge pages */
   unsetenv(NOTE_VAR);
 #endif
 }

@@ -8,10 +8,13 @@
  * Idle OpenMP threads spin by default (libgomp: about 300,000 polls before sleeping at
  * every barrier), which costs little on idle cores but, when the cores are busy with
  * other work, burns the time slices the working threads need: a MINRES solve with many
- * short parallel regions ran 20-30x slower beside a load of 8 on 2 cores. The programs
- * therefore wait passively (OMP_WAIT_POLICY=passive: idle threads sleep at once), unless
- * the user has set one of OMP_WAIT_POLICY, GOMP_SPINCOUNT and KMP_BLOCKTIME (e.g.
- * OMP_WAIT_POLICY=active on dedicated cores).
+ * short parallel regions ran 20-30x slower beside a load of 8 on 2 cores. Sleeping at once
+ * (OMP_WAIT_POLICY=passive) avoids that, but then every parallel region after a sequential
+ * stretch waits for its threads to wake, which on idle cores makes short regions slower.
+ * The programs run between the two: a waiting thread polls 10,000 times before it sleeps
+ * (GOMP_SPINCOUNT=10000), unless the user has set one of OMP_WAIT_POLICY, GOMP_SPINCOUNT and
+ * KMP_BLOCKTIME (OMP_WAIT_POLICY=passive on machines kept busy by other work,
+ * OMP_WAIT_POLICY=active on dedicated cores; lib/docs/performance.md, "OpenMP waiting").
  *
  * An OpenBLAS older than the CPU runs generic kernels (fcm_blas_info_get(): Debian 12's
  * OpenBLAS runs SSE3 kernels on recent AVX-512 CPUs, DGEMM and so CHOLMOD several times
@@ -35,7 +38,7 @@
  * continues as it started. Returns only when no re-execution took place. */
 void app_env_init(int argc, char **argv);
 
-/** app_env_init() for the BLAS kernels only, leaving the OpenMP wait policy and malloc as the
+/** app_env_init() for the BLAS kernels only, leaving the OpenMP waiting and malloc as the
  * program was started with (benchmarks that measure the policies themselves). */
 void app_env_init_blas(int argc, char **argv);
 

@@ -24,8 +24,8 @@ fcm_add_app(fcm-cutbench apps/fcm-cutbench.c apps/fcm-cutbench-scenes.c apps/fcm
             apps/fcm-cutbench-output.c)
 # fcm-models finds its built-in pebble (apps/scenes/models/pebble.obj) in the source tree.
 target_compile_definitions(fcm-models PRIVATE FCM_MODELS_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-# Every program waits passively in OpenMP and selects the CPU's OpenBLAS kernels unless the user
-# says otherwise (apps/app_env.h).
+# Every program spins briefly in OpenMP, selects the CPU's OpenBLAS kernels and puts malloc's
+# memory on huge pages unless the user says otherwise (apps/app_env.h).
 foreach(app fcm-sim fcm-rulegen fcm-quadrature fcm-condition fcm-converge fcm-cut fcm-scaling
             fcm-models fcm-cutbench)
   target_sources(${app} PRIVATE apps/app_env.c)

@@ -278,7 +278,7 @@ static int parse_args(int argc, char **argv, config *c)
 
 int main(int argc, char **argv)
 {
-  app_env_init(argc, argv);    /* passive OpenMP waiting, the CPU's BLAS kernels (app_env.h) */
+  app_env_init(argc, argv);    /* OpenMP waiting, the CPU's BLAS kernels, huge pages (app_env.h) */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   config c;
   memset(&c, 0, sizeof c);

@@ -250,7 +250,7 @@ static void usage(FILE *f)
 
 int main(int argc, char **argv)
 {
-  app_env_init(argc, argv);    /* passive OpenMP waiting, the CPU's BLAS kernels (app_env.h) */
+  app_env_init(argc, argv);    /* OpenMP waiting, the CPU's BLAS kernels, huge pages (app_env.h) */
   fcm_blas_set_num_threads(1); /* fcm's OpenMP cell loops call LAPACK: no nested BLAS threads */
   if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
     usage(argc < 2 ? stderr : stdout);

@@ -332,7 +332,7 @@ static int parse_args(int argc, char **argv, config *c, shape_list *shapes, int 
 
 int main(int argc, char **argv)
 {
-  app_env_init(argc, argv); /* passive OpenMP waiting, the CPU's BLAS kernels (app_env.h) */
+  app_env_init(argc, argv); /* OpenMP waiting, the CPU's BLAS kernels, huge pages (app_env.h) */
   config cfg;
   shape_list shapes = {{FCM_SHAPE_LINE}, 0};
   int strengths[2] = {1, 10};

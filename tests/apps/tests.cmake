@@ -130,7 +130,7 @@ fcm_add_test(app_fault_kill_long tests/apps/fault_app.c LABELS app slow TIMEOUT 
 fcm_add_test(app_fault_diskfull tests/apps/fault_app.c LABELS app ARGS diskfull ${fault_args})
 fcm_add_test(app_fault_dirsync tests/apps/fault_app.c LABELS app ARGS dirsync ${fault_args})
 add_dependencies(app_fault_kill fcm_fault_shim fcm-sim) # the program of the app_fault_* tests
-# apps/app_env.c: passive OpenMP waiting by default, the user's OMP_WAIT_POLICY / GOMP_SPINCOUNT
+# apps/app_env.c: a short OpenMP spin by default, the user's OMP_WAIT_POLICY / GOMP_SPINCOUNT
 # kept; the CPU's OpenBLAS kernels selected when a shim makes OpenBLAS name its SSE3 ones, the
 # user's OPENBLAS_CORETYPE and FCM_BLAS_CORETYPE=keep respected.
 add_library(fcm_corename_shim SHARED tests/support/corename_shim.c)
