@@ -16,7 +16,11 @@
  * the carry is the same hierarchy, and its allocation failures, in either part, are reported
  * (by the creation or the join) and leak nothing. The embedded hemisphere of mg_util.h, Hex8
  * and Hex20, V- and W-cycles (the W-cycle's finest blocks only at the cells with a piece under
- * half the cell: fcm_mg_options.block_fraction 0.5). */
+ * half the cell: fcm_mg_options.block_fraction 0.5). A carried hierarchy takes the old one's
+ * Galerkin storage where it fits (fcm__mg_take_scratch(), as an integrator's cut does) before
+ * its set-up, with the same bits; on one pattern a hierarchy takes every product's scratch and
+ * every coarse matrix's values from another one set up before (the arrays' addresses), with
+ * the same bits as a plain creation's; one set up already, or NULL, takes nothing. */
 #include "fem/fem_impl.h"
 #include "mg/levels_impl.h"
 #include "mg_compare.h"
@@ -83,11 +87,45 @@ static fcm_mg *beside_carry(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *pr
 /* Carries whose coarsest analysis took the old hierarchy's ordering. */
 static int orderings_taken;
 
+/* Two hierarchies on p's pattern: the second takes the first's Galerkin storage after the
+ * first's set-up (every array: the same sizes), and both set up equal `ref` bit for bit. */
+static void same_pattern_take(fcm_ctx *ctx, const problem *p, const fcm_csr *pattern,
+                              const unsigned char *inactive, const fcm_mg_options *o, fcm_mg *ref)
+{
+  fcm_mg *a = NULL, *b = NULL;
+  TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, p->space, pattern, inactive, o, &a));
+  TEST_OK(ctx, fcm__mg_create_pattern(ctx, NULL, p->space, pattern, inactive, o, &b));
+  if (!a || !b) goto done;
+  TEST_OK(ctx, fcm_mg_setup(a));
+  TEST_TRUE(a->nlev == b->nlev && a->nlev >= 2);
+  TEST_TRUE(fcm__mg_take_scratch(a, b) == 0); /* a is set up: it takes nothing */
+  TEST_TRUE(fcm__mg_take_scratch(NULL, a) == 0 && fcm__mg_take_scratch(b, NULL) == 0);
+  TEST_TRUE(fcm__mg_take_scratch(b, b) == 0);
+  const void *ap[MG_MAX_LEVELS], *cv[MG_MAX_LEVELS];
+  for (int l = 0; l + 1 < a->nlev; l++) {
+    ap[l] = fcm__ptap_scratch(a->lev[l].ptap);
+    cv[l] = fcm_csr_values_read(a->lev[l + 1].Aown);
+  }
+  TEST_TRUE(fcm__mg_take_scratch(b, a) == 2 * (a->nlev - 1));
+  for (int l = 0; l + 1 < b->nlev; l++) {
+    TEST_TRUE(fcm__ptap_scratch(b->lev[l].ptap) == ap[l] && !fcm__ptap_scratch(a->lev[l].ptap));
+    TEST_TRUE(fcm_csr_values_read(b->lev[l + 1].Aown) == cv[l]);
+  }
+  fcm_mg_destroy(&a); /* all it can do now */
+  TEST_OK(ctx, fcm_mg_setup(b));
+  TEST_TRUE(mgc_same(ctx, b, ref, p->b, p->n, 2));
+done:
+  fcm_mg_destroy(&a);
+  fcm_mg_destroy(&b);
+}
+
+/* Arrays the carried hierarchies took from the old ones (fcm__mg_take_scratch()). */
+static int scratch_taken;
+
 /* The hierarchy carried from old (NULL: none; on prev's space) to p's pattern, then set up,
  * against fcm_mg_create() and the reference pattern; *pattern: its level-0 matrix. */
-static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_space *prev,
-                                 const problem *p, const fcm_mg_options *o, const char *what,
-                                 fcm_csr **pattern)
+static fcm_mg *carry_and_compare(fcm_ctx *ctx, fcm_mg *old, const fcm_space *prev, const problem *p,
+                                 const fcm_mg_options *o, const char *what, fcm_csr **pattern)
 {
   fcm_mg *prep = NULL, *fresh = NULL;
   unsigned char *inactive = mgc_eliminated(p->A, p->n);
@@ -132,11 +170,15 @@ static fcm_mg *carry_and_compare(fcm_ctx *ctx, const fcm_mg *old, const fcm_spac
     if (x) TEST_ERR(ctx, fcm_mg_solve(prep, p->b, x, 1e-8, 2, NULL), FCM_ERR_ARG, "no values yet");
     free(x);
   }
+  /* as an integrator's cut: the old hierarchy is destroyed after this (its patterns are still
+   * compared below) */
+  if (old) scratch_taken += fcm__mg_take_scratch(prep, old);
   TEST_OK(ctx, fcm_mg_setup(prep));
   TEST_OK(ctx, fcm_mg_setup(bes));
   TEST_TRUE(mgc_same(ctx, prep, bes, p->b, p->n, 2));
   fcm_mg_destroy(&bes);
   TEST_OK(ctx, fcm_mg_create(ctx, p->space, p->A, o, &fresh));
+  if (!old) same_pattern_take(ctx, p, *pattern, inactive, o, fresh);
   const int same = mgc_same(ctx, prep, fresh, p->b, p->n, 2);
   int exact = 1;
   fcm_index coarse_rows = 0;
@@ -454,6 +496,8 @@ int main(void)
   cut_sequence(ctx, FCM_ELEMENT_HEX8);
   cut_sequence(ctx, FCM_ELEMENT_HEX20);
   TEST_TRUE(orderings_taken >= 2); /* the first cut of each element keeps the coarsest pattern */
+  if (getenv("FCM_TEST_VERBOSE"))
+    printf("Galerkin arrays the carried hierarchies took from the old ones: %d\n", scratch_taken);
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
 }

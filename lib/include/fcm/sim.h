@@ -236,7 +236,9 @@ typedef struct fcm_integrator_options {
                       matrices take the storage of this one's where it is large enough (a
                       large matrix has a quarter more room than it needs), on pages already
                       mapped instead of new ones, whose first touch costs more than the
-                      assembly at a few hundred thousand DOFs (a serial integrator only). With
+                      assembly at a few hundred thousand DOFs (a serial integrator only); so do
+                      the Galerkin products of its multigrid hierarchy (their scratch and the
+                      coarse levels' values, at its first set-up). With
                       this flag the room of the Newton and mass matrices, of the kept element
                       blocks and of the corotated element store is mapped when they are made:
                       a quarter more resident memory for them, no page faults when a cut grows

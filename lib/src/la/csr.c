@@ -176,6 +176,18 @@ void fcm__csr_map_room(fcm_csr *A)
   if (A && A->owned) fcm__large_map(A->values);
 }
 
+int fcm__csr_take_values(fcm_csr *A, fcm_csr *give)
+{
+  if (!A || !give || A == give || !A->owned || !give->owned || !give->values) return 0;
+  void *from = give->values;
+  double *v = fcm__large_take(&from, (size_t)A->nnz, sizeof *v);
+  if (!v) return 0;
+  fcm__free_large(A->ctx, A->values);
+  A->values = v;
+  give->values = NULL;
+  return 1;
+}
+
 int fcm__csr_give_back(fcm_csr *from, fcm_csr *to)
 {
   if (!from || !to || !from->owned || !to->owned || !from->values || to->values) return 0;

@@ -137,6 +137,12 @@ fcm_status fcm__csr_share_pattern_from(fcm_ctx *ctx, fcm_index nrows, fcm_index 
  * a matrix whose storage a successor will take (fcm__csr_share_pattern_from()). */
 void fcm__csr_map_room(fcm_csr *A);
 
+/* A (owning its values, not yet written: a Galerkin product's before its first set-up) takes
+ * the storage of give's values (a matrix about to be destroyed) when it holds A's: A's own,
+ * never touched, is freed, A's values are then give's bits until written, and give is left
+ * without values (destroy only). Returns 1 when taken, else 0 (nothing changed). (csr.c) */
+int fcm__csr_take_values(fcm_csr *A, fcm_csr *give);
+
 /* The values storage `to` gave to `from` (fcm__csr_share_pattern_from()) back to `to`: 1 when
  * given back (to's values then as from's left them, from without values: destroy only); 0 when
  * there is nothing to give back (to has values, or from none of its own). (csr.c) */
@@ -225,6 +231,15 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
  * A has the pattern given to fcm__ptap_create(), C is the matrix it created. Allocates
  * nothing; one call at a time per plan. */
 void fcm__ptap_apply(fcm__ptap *plan, const fcm_csr *A, fcm_csr *C, int nt);
+
+/* The plan t takes the storage of give's A P values (a plan of a hierarchy before a cut, about
+ * to be destroyed) when it holds t's: t's own, never touched, is freed, and its products then
+ * write into pages already mapped instead of faulting fresh ones in. give is left without it:
+ * it can only be destroyed. Returns 1 when taken, else 0 (nothing changed). */
+int fcm__ptap_take_scratch(fcm__ptap *t, fcm__ptap *give);
+
+/* The storage of the plan's A P values (NULL for NULL, or once taken). */
+const double *fcm__ptap_scratch(const fcm__ptap *t);
 
 /* R = P^T (nc x n) as the plan holds it: row J lists the rows of P with a column J,
  * ascending. Valid while the plan lives. */

@@ -552,7 +552,7 @@ void fcm__ptap_destroy(fcm__ptap **plan)
   fcm__free(ctx, t->R_val);
   fcm__free(ctx, t->AP_ptr);
   fcm__free(ctx, t->AP_col);
-  fcm__free(ctx, t->AP_val);
+  fcm__free_large(ctx, t->AP_val);
   fcm__free(ctx, t->spa);
   fcm__free(ctx, t->same3);
   fcm__free(ctx, t->r_kind);
@@ -638,7 +638,9 @@ fcm_status fcm__ptap_create(fcm_ctx *ctx, const fcm_csr *A, fcm_index nc, const 
   FCM_TRY(ctx, fcm__ptap_product_pattern(ctx, nt, n, fcm_csr_row_ptr(A), fcm_csr_col_idx(A), P_ptr,
                                          P_col, nc, 0, dup, pnode, closed, NULL, 0, &t->AP_ptr,
                                          &t->AP_col));
-  FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
+  /* every product writes all of it; a large array, which a successor may take
+   * (fcm__ptap_take_scratch()) */
+  FCM__ALLOC_WITH(fcm__malloc_large, ctx, t->AP_ptr[n] + 1, t->AP_val);
   /* A P's groups of three rows of one pattern: those of A's (the same columns in the same
    * order, dup above) and any other whose rows agree */
   FCM_ALLOC(ctx, n / 3 + 1, ap3);
@@ -682,6 +684,23 @@ void fcm__ptap_apply(fcm__ptap *t, const fcm_csr *A, fcm_csr *C, int nt)
     product_values(nc, t->R_ptr, t->R_col, t->R_val, t->AP_ptr, t->AP_col, t->AP_val, cp, cc, cv,
                    spa, t->r_kind);
   }
+}
+
+int fcm__ptap_take_scratch(fcm__ptap *t, fcm__ptap *give)
+{
+  if (!t || !give || t == give) return 0;
+  void *from = give->AP_val;
+  double *v = fcm__large_take(&from, (size_t)t->AP_ptr[t->n] + 1, sizeof *v);
+  if (!v) return 0;
+  fcm__free_large(t->ctx, t->AP_val);
+  t->AP_val = v;
+  give->AP_val = NULL;
+  return 1;
+}
+
+const double *fcm__ptap_scratch(const fcm__ptap *t)
+{
+  return t ? t->AP_val : NULL;
 }
 
 void fcm__ptap_transpose(const fcm__ptap *t, const fcm_index **R_ptr, const int **R_col,

@@ -250,7 +250,7 @@ fcm_status fcm__ptap_create_from(fcm_ctx *ctx, const fcm__ptap_prior *prior, con
       w.prow[i] = (unsigned char)carry_prow(&w, i);
   }
   FCM_TRY(ctx, carry_rows(ctx, &w, 0, nt, &t->AP_ptr, &t->AP_col));
-  FCM_ALLOC_RAW(ctx, t->AP_ptr[n] + 1, t->AP_val); /* every product writes all of it */
+  FCM__ALLOC_WITH(fcm__malloc_large, ctx, t->AP_ptr[n] + 1, t->AP_val); /* as in ptap.c */
   FCM_ALLOC(ctx, n / 3 + 1, ap3);
 #pragma omp parallel for num_threads(nt) schedule(static) if (nt > 1 && n > 4096)
   for (fcm_index g = 0; g < n / 3; g++)

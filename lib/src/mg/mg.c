@@ -523,6 +523,17 @@ cleanup:
   return st;
 }
 
+int fcm__mg_take_scratch(fcm_mg *m, fcm_mg *old)
+{
+  if (!m || !old || m == old || !m->values_pending) return 0;
+  int taken = 0;
+  for (int l = 0; l + 1 < m->nlev && l + 1 < old->nlev; l++) {
+    taken += fcm__ptap_take_scratch(m->lev[l].ptap, old->lev[l].ptap);
+    taken += fcm__csr_take_values(m->lev[l + 1].Aown, old->lev[l + 1].Aown);
+  }
+  return taken;
+}
+
 fcm_status fcm_mg_create(fcm_ctx *ctx, const fcm_space *space, const fcm_csr *A,
                          const fcm_mg_options *opts, fcm_mg **mg)
 {

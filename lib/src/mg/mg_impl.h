@@ -154,6 +154,15 @@ FCM_COMPONENT_API fcm_status fcm__mg_join(fcm_mg *m, double *seconds);
  * (its plan needs level 0's pattern). Accepts NULL. */
 FCM_COMPONENT_API void fcm__mg_detach(fcm_mg *m);
 
+/* m, created on a pattern and not yet set up (fcm__mg_create_pattern_cut() and the like),
+ * takes the storage of old's Galerkin products where it holds m's, level by level: the
+ * products' scratch (A P) and the coarse matrices' values (fcm__ptap_take_scratch(),
+ * fcm__csr_take_values()). m's first set-up then writes into pages already mapped instead of
+ * faulting fresh ones in; its results are the same. old (a hierarchy that nothing shares with
+ * m, about to be destroyed) can only be destroyed afterwards. Returns the arrays taken (0 for
+ * NULL arguments, or when m is set up already). */
+FCM_COMPONENT_API int fcm__mg_take_scratch(fcm_mg *m, fcm_mg *old);
+
 /* What m's creation kept (all zero for NULL). */
 FCM_COMPONENT_API void fcm__mg_get_kept(const fcm_mg *m, fcm__mg_kept *kept);
 

@@ -4,6 +4,7 @@
 #include "sim/sim_impl.h"
 #include "fem/fem_impl.h"
 #include "la/la_impl.h"
+#include "mg/mg_impl.h"
 
 #include <math.h>
 #include <string.h>
@@ -856,8 +857,10 @@ fcm_status fcm__integrator_cut_end(fcm__integrator_cut *cut, fcm_status st, fcm_
     I->load_work = cut->old->load_work;
     *integ = I;
     I = NULL;
-    if (cut->giver) /* its storage is the new integrator's */
+    if (cut->giver) { /* its storage is the new integrator's, its hierarchy's products' too */
       cut->giver->spent = 1, cut->giver->is_setup = 0;
+      fcm__mg_take_scratch((*integ)->mg, cut->giver->mg);
+    }
   }
   if (I && cut->giver) fcm__sim_cut_give_back(I, cut->giver); /* failed: old goes on */
   fcm__free(ctx, cut->con);
