@@ -18,9 +18,11 @@
 /* Set in the re-executed program: the kernels OpenBLAS had chosen before the selection. */
 #define NOTE_VAR "FCM_BLAS_CORETYPE_REPLACED"
 
-/* glibc's malloc (2.35 and later; others ignore it): its heap and its mapped blocks advised
- * for transparent huge pages (app_env.h) */
-#define MALLOC_TUNABLES "glibc.malloc.hugetlb=1"
+/* glibc's malloc (hugetlb: 2.35 and later; others ignore what they do not know): its heap
+ * advised for transparent huge pages, every block from the heap (none mapped alone) and freed
+ * memory kept up to 4 GiB at the heap's top (app_env.h) */
+#define MALLOC_TUNABLES                                                                            \
+  "glibc.malloc.hugetlb=1:glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=4294967296"
 
 /* libgomp's polls of a waiting OpenMP thread before it sleeps (app_env.h) */
 #define SPINCOUNT "10000"

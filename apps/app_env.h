@@ -23,11 +23,15 @@
  * FCM_BLAS_CORETYPE=keep keeps the kernels OpenBLAS chose.
  *
  * Memory the program touches for the first time costs a page fault per 4 KiB page, which on
- * virtual machines can cost several times the page's zero fill. Unless the user has set
- * GLIBC_TUNABLES (an empty value keeps glibc's defaults), the programs run with
- * glibc.malloc.hugetlb=1: malloc advises its heap and its mapped blocks for transparent huge pages
- * (where the kernel offers them on request), so that they fault in 2 MiB at a time
- * (lib/docs/performance.md, "Page faults").
+ * virtual machines can cost several times the page's zero fill, and glibc gives blocks of 128
+ * KiB and more back to the kernel when they are freed, so that a cut's new arrays fault in
+ * again. Unless the user has set GLIBC_TUNABLES (an empty value keeps glibc's defaults), the
+ * programs run with glibc.malloc.hugetlb=1 (malloc advises its heap for transparent huge pages,
+ * where the kernel offers them on request: they fault in 2 MiB at a time),
+ * glibc.malloc.mmap_max=0 (every block comes from the heap, none is mapped alone) and
+ * glibc.malloc.trim_threshold=4294967296 (freed memory stays with the process up to 4 GiB at the
+ * heap's top), so that freed arrays are used again without faults (lib/docs/performance.md,
+ * "Page faults").
  *
  * The runtimes read their environment when they are loaded, before main(), so setting the
  * variables here would come too late (and a .preinit_array function cannot set them either:

@@ -10,19 +10,25 @@
  * runs once and the user's values are in effect; under the SSE3 kernels on a CPU with AVX or
  * more, it runs twice with OPENBLAS_CORETYPE = the CPU's kernel set and says so in one line
  * on stderr; OPENBLAS_CORETYPE set by the user or FCM_BLAS_CORETYPE=keep: one run, no note.
- * With GLIBC_TUNABLES unset it runs twice with glibc.malloc.hugetlb=1 in it (alone, or with
- * the other changes in one re-execution); set by the user, even empty, it is kept. The other
- * cases run with GLIBC_TUNABLES empty (glibc's defaults kept). */
+ * With GLIBC_TUNABLES unset it runs twice with the programs' malloc tunables in it (alone, or
+ * with the other changes in one re-execution), and a 64 MiB block then comes from the heap
+ * (mallinfo2()); set by the user, even empty, it is kept, and glibc maps such a block alone.
+ * The other cases run with GLIBC_TUNABLES empty (glibc's defaults kept). */
 #define _POSIX_C_SOURCE 200809L
 #include "../../apps/app_env.h"
 #include "test.h"
 
 #include <fcm/la.h>
+#include <malloc.h>
 #include <omp.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #define RUNS_VAR "FCM_TEST_APP_ENV_RUNS"
+
+/* The malloc tunables the programs set (apps/app_env.c) */
+#define MALLOC                                                                                     \
+  "glibc.malloc.hugetlb=1:glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=4294967296"
 
 static int probe(int argc, char **argv)
 {
@@ -33,10 +39,18 @@ static int probe(int argc, char **argv)
   app_env_init(argc, argv);
   const char *p = getenv("OMP_WAIT_POLICY"), *c = getenv("OPENBLAS_CORETYPE"),
              *t = getenv("GLIBC_TUNABLES");
-  printf("runs=%s policy=%s coretype=%s tunables=%s\n", getenv(RUNS_VAR), p ? p : "-", c ? c : "-",
+  /* a 64 MiB block: mapped alone under glibc's defaults (above its largest mmap threshold) */
+  char *big = malloc((size_t)64 << 20);
+  const struct mallinfo2 mi = mallinfo2();
+  const int mapped = big && mi.hblks > 0;
+  if (big) big[0] = 1;
+  free(big);
+  printf("runs=%s policy=%s coretype=%s tunables=%s mapped=%d\n", getenv(RUNS_VAR), p ? p : "-",
+         c ? c : "-",
          !t     ? "-"
          : t[0] ? t
-                : "(empty)");
+                : "(empty)",
+         mapped);
   fflush(stdout);
   omp_display_env(1); /* to stderr */
   return 0;
@@ -59,6 +73,7 @@ typedef struct probe_out {
   char policy[64];     /* OMP_WAIT_POLICY in its environment, "-" unset */
   char coretype[64];   /* OPENBLAS_CORETYPE in its environment, "-" unset */
   char tunables[256];  /* GLIBC_TUNABLES in its environment, "-" unset, "(empty)" */
+  int mapped;          /* a 64 MiB block was mapped alone (glibc's default) */
   int blas_notes;      /* lines on stderr saying which kernels were selected */
   char blas_note[512]; /* the last one */
 } probe_out;
@@ -97,9 +112,10 @@ static void run(const char *self, const char *dir, probe_env e, probe_out *o)
   memset(o, 0, sizeof *o);
   o->runs = -1;
   o->spincount = -1;
+  o->mapped = -1;
   FILE *f = fopen(out, "r");
-  TEST_TRUE(f && fscanf(f, "runs=%d policy=%63s coretype=%63s tunables=%255s", &o->runs, o->policy,
-                        o->coretype, o->tunables) == 4);
+  TEST_TRUE(f && fscanf(f, "runs=%d policy=%63s coretype=%63s tunables=%255s mapped=%d", &o->runs,
+                        o->policy, o->coretype, o->tunables, &o->mapped) == 5);
   if (f) fclose(f);
   /* the last GOMP_SPINCOUNT line is the final process's */
   f = fopen(err, "r");
@@ -167,16 +183,17 @@ int main(int argc, char **argv)
 
   /* malloc: GLIBC_TUNABLES unset gets huge pages, alone or in the one re-execution */
   run(self, dir, (probe_env){.policy = "active", .mode = "keep", .no_tunables = 1}, &o);
-  TEST_TRUE(o.runs == 2 && !strcmp(o.tunables, "glibc.malloc.hugetlb=1") &&
-            !strcmp(o.policy, "active"));
+  TEST_TRUE(o.runs == 2 && !strcmp(o.tunables, MALLOC) && !strcmp(o.policy, "active"));
+  TEST_TRUE(o.mapped == 0);
   run(self, dir, (probe_env){.mode = "keep", .no_tunables = 1}, &o);
-  TEST_TRUE(o.runs == 2 && !strcmp(o.tunables, "glibc.malloc.hugetlb=1") &&
+  TEST_TRUE(o.runs == 2 && !strcmp(o.tunables, MALLOC) &&
             (o.spincount == 10000 || o.spincount == -1));
+  TEST_TRUE(o.mapped == 0);
   /* the user's tunables win, even empty */
   run(self, dir,
       (probe_env){.policy = "active", .mode = "keep", .tunables = "glibc.malloc.arena_max=2"}, &o);
-  TEST_TRUE(o.runs == 1 && !strcmp(o.tunables, "glibc.malloc.arena_max=2"));
+  TEST_TRUE(o.runs == 1 && !strcmp(o.tunables, "glibc.malloc.arena_max=2") && o.mapped == 1);
   run(self, dir, (probe_env){.policy = "active", .mode = "keep"}, &o);
-  TEST_TRUE(o.runs == 1 && !strcmp(o.tunables, "(empty)"));
+  TEST_TRUE(o.runs == 1 && !strcmp(o.tunables, "(empty)") && o.mapped == 1);
   return TEST_RESULT();
 }
