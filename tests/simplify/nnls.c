@@ -282,21 +282,24 @@ static void fit(fcm_ctx *ctx)
   }
 }
 
-/* fcm__fit_dgemv_t / fcm__fit_sgemv_t against the sums in long double: |error| <= m eps
- * sum_i |a_i x_i| (any summation order), for m rows of every remainder modulo 8 (double; the
- * single-precision kernel takes rows padded to 16) and n of every remainder modulo 8. */
+/* fcm__fit_dgemv_t against the sums in long double: |error| <= m eps sum_i |a_i x_i| (any
+ * summation order), for m rows of every remainder modulo 8 and n of every remainder modulo 8;
+ * fcm__fit_sgemv_rows (A by rows) against the plain loop over the rows in order, bit for bit,
+ * for n of every remainder modulo 8 and of 32 (its lanes sum no two columns' terms together). */
 static void products(void)
 {
-  enum { LDA = 70, NMAX = 19 };
+  enum { LDA = 70, NMAX = 19, LDR = 75 };
   uint64_t s = 12345;
   double A[LDA * NMAX], x[LDA], y[NMAX];
-  float Af[LDA * NMAX], xf[LDA], yf[NMAX];
+  float Ar[LDA * LDR], xf[LDA], yf[LDR];
   for (int e = 0; e < LDA * NMAX; e++)
-    A[e] = 2.0 * util_rand(&s) - 1.0, Af[e] = (float)A[e];
+    A[e] = 2.0 * util_rand(&s) - 1.0;
+  for (int e = 0; e < LDA * LDR; e++)
+    Ar[e] = (float)(2.0 * util_rand(&s) - 1.0);
   for (int i = 0; i < LDA; i++)
     x[i] = 2.0 * util_rand(&s) - 1.0, xf[i] = (float)x[i];
-  int bad = 0;
-  for (int m = 1; m <= 64; m++)
+  int bad = 0, sbad = 0;
+  for (int m = 1; m <= 64; m++) {
     for (int n = 0; n <= NMAX; n += 1) {
       fcm__fit_dgemv_t(m, n, A, LDA, x, y);
       for (int j = 0; j < n; j++) {
@@ -305,16 +308,21 @@ static void products(void)
           t += (long double)A[j * LDA + i] * x[i], mag += fabsl((long double)A[j * LDA + i] * x[i]);
         bad += !(fabsl((long double)y[j] - t) <= m * DBL_EPSILON * mag + 1e-300);
       }
-      if (m % 16) continue;
-      fcm__fit_sgemv_t(m, n, Af, LDA, xf, yf);
+    }
+    for (int n = 0; n <= LDR; n += m % 7 + 1) {
+      fcm__fit_sgemv_rows(m, n, Ar, LDR, xf, yf);
       for (int j = 0; j < n; j++) {
-        double t = 0.0, mag = 0.0;
-        for (int i = 0; i < m; i++)
-          t += (double)Af[j * LDA + i] * xf[i], mag += fabs((double)Af[j * LDA + i] * xf[i]);
-        bad += !(fabs((double)yf[j] - t) <= m * FLT_EPSILON * mag + 1e-30);
+        volatile float t = 0.0f; /* one rounding per product and per sum, in order */
+        for (int i = 0; i < m; i++) {
+          volatile float p = Ar[i * LDR + j] * xf[i];
+          t = t + p;
+        }
+        sbad += memcmp(&yf[j], (const void *)&t, sizeof t) != 0;
       }
     }
+  }
   TEST_TRUE(bad == 0);
+  TEST_TRUE(sbad == 0);
 }
 
 /* fcm__nnls_top_cosine() against one running maximum over the columns in order: the same value,

@@ -129,9 +129,6 @@ cleanup:
  * optimality test stay in double. */
 #define NNLS_SINGLE_TRUST 1e-3
 
-/* Rows of the float copy of A (and of the residual): M padded to a multiple of 16. */
-#define NNLS_MF(M) (((M) + 15) / 16 * 16)
-
 typedef struct nnls_qr {
   int M, np, kcols; /* rows, passive columns, columns of A */
   double *Q;        /* M x M orthogonal, times the pending reflections (nref) */
@@ -516,14 +513,13 @@ static fcm_status nnls_start(fcm_ctx *ctx, int M, int k, const double *A, const 
     FCM_ALLOC(ctx, (size_t)k, w->gl);
     FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, w->AL);
   }
-  if (k > M) { /* rows padded with zeros to NNLS_MF(M) (fcm__fit_sgemv_t()) */
-    const size_t mf = (size_t)NNLS_MF(M);
-    FCM_ALLOC_RAW(ctx, mf * (size_t)k, w->Af);
-    FCM_ALLOC(ctx, mf, w->rf);
+  if (k > M) { /* by rows, the candidates side by side (fcm__fit_sgemv_rows()) */
+    FCM_ALLOC_RAW(ctx, (size_t)M * (size_t)k, w->Af);
+    FCM_ALLOC(ctx, (size_t)M, w->rf);
     FCM_ALLOC_RAW(ctx, (size_t)k, w->gf);
     for (size_t j = 0; j < (size_t)k; j++)
-      for (size_t i = 0; i < mf; i++)
-        w->Af[j * mf + i] = i < (size_t)M ? (float)A[j * (size_t)M + i] : 0.0f;
+      for (size_t i = 0; i < (size_t)M; i++)
+        w->Af[i * (size_t)k + j] = (float)A[j * (size_t)M + i];
   }
   for (int i = 0; i < M; i++)
     s->Q[i + (size_t)i * (size_t)M] = 1.0;
@@ -586,7 +582,7 @@ static double nnls_price(nnls_qr *s, nnls_work *w, const double *A, int it, int 
   if (full && *single) {
     for (int i = 0; i < M; i++)
       w->rf[i] = (float)w->r[i];
-    fcm__fit_sgemv_t(NNLS_MF(M), k, w->Af, NNLS_MF(M), w->rf, w->gf);
+    fcm__fit_sgemv_rows(M, k, w->Af, k, w->rf, w->gf);
     const float *gf = w->gf;
     for (int j = 0; j < k; j++)
       g[j] = (double)gf[j];

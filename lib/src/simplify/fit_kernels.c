@@ -1,9 +1,9 @@
-/* NNLS's matrix-vector products y = A^T x (A column-major): Q^T a for each column tried, and
- * the gradient A^T r over the candidates in single precision. At NNLS's sizes (M = 120 rows,
- * Q 115 KB and the float candidates 300 KB, both from L2) a call is a few thousand cycles, and
- * a BLAS's kernel for any shape runs them on narrower vectors and with more set-up: these
- * take eight columns at a time, each an accumulator of 8 doubles or 16 floats over the rows,
- * and sum the accumulators' lanes together in one tree of shuffles. Compiled as per-CPU clones
+/* NNLS's matrix-vector products y = A^T x: Q^T a for each column tried (Q column-major), and
+ * the gradient A^T r over the candidates in single precision (A's float copy by rows). At
+ * NNLS's sizes (M = 27 to 220 rows, Q up to 390 KB, the float candidates up to 1 MB) a call is
+ * a few thousand cycles, and a BLAS's kernel for any shape runs them on narrower vectors and
+ * with more set-up. Q^T a takes four columns at a time (dgemv_t()); the gradient runs the
+ * candidates in the lanes (sgemv_rows()). Compiled as per-CPU clones
  * (core/multiversion.h); without contraction the clones give the same bits as the baseline:
  * the same lanes, sums and order. */
 #include "core/multiversion.h"
@@ -12,104 +12,98 @@
 #include <string.h>
 
 #if defined(__GNUC__) && !defined(__clang__)
-typedef double fit_v8d __attribute__((vector_size(64)));
-typedef long long fit_v8i __attribute__((vector_size(64)));
-typedef float fit_v16f __attribute__((vector_size(64)));
+typedef double fit_v4d __attribute__((vector_size(32)));
+typedef long long fit_v4i __attribute__((vector_size(32)));
 typedef float fit_v8f __attribute__((vector_size(32)));
-typedef int fit_v8fi __attribute__((vector_size(32)));
 
-/* The lanes' sums of eight vectors, lane j of the result the sum of c[j]: pairs interleaved,
- * then quadruples, then the halves. */
-#define FIT_TREE(V, I, c, out)                                                                     \
-  do {                                                                                             \
-    const I e_ = {0, 8, 2, 10, 4, 12, 6, 14}, o_ = {1, 9, 3, 11, 5, 13, 7, 15};                    \
-    const I lo_ = {0, 1, 8, 9, 4, 5, 12, 13}, hi_ = {2, 3, 10, 11, 6, 7, 14, 15};                  \
-    const I l4_ = {0, 1, 2, 3, 8, 9, 10, 11}, h4_ = {4, 5, 6, 7, 12, 13, 14, 15};                  \
-    V p_[4], q_[2];                                                                                \
-    for (int t_ = 0; t_ < 4; t_++)                                                                 \
-      p_[t_] = __builtin_shuffle(c[2 * t_], c[2 * t_ + 1], e_) +                                   \
-               __builtin_shuffle(c[2 * t_], c[2 * t_ + 1], o_);                                    \
-    for (int t_ = 0; t_ < 2; t_++)                                                                 \
-      q_[t_] = __builtin_shuffle(p_[2 * t_], p_[2 * t_ + 1], lo_) +                                \
-               __builtin_shuffle(p_[2 * t_], p_[2 * t_ + 1], hi_);                                 \
-    out = __builtin_shuffle(q_[0], q_[1], l4_) + __builtin_shuffle(q_[0], q_[1], h4_);             \
-  } while (0)
-
-/* y[0..8) = A[:, 0..8)^T x over rows [0, m8) (a multiple of 8), the rest of the rows added
- * after the vector sums. */
-static inline __attribute__((always_inline)) void dcols8(int m, const double *A, int lda,
-                                                         const double *x, double *y)
-{
-  const int m8 = m / 8 * 8;
-  fit_v8d c[8] = {{0}}, xv, a, out;
-  for (int r = 0; r < m8; r += 8) {
-    memcpy(&xv, x + r, sizeof xv);
-    for (int j = 0; j < 8; j++) {
-      memcpy(&a, A + (size_t)j * (size_t)lda + r, sizeof a);
-      c[j] += a * xv;
-    }
-  }
-  FIT_TREE(fit_v8d, fit_v8i, c, out);
-  for (int j = 0; j < 8; j++) {
-    double t = out[j];
-    for (int r = m8; r < m; r++)
-      t += A[(size_t)j * (size_t)lda + r] * x[r];
-    y[j] = t;
-  }
-}
-
-/* The clones are static: a cloned function's dispatcher would otherwise be exported from the
- * shared library whatever the visibility (the ifunc resolver keeps default visibility), so the
- * module's entry points below only call them. */
+/* y[0..n) = A^T x, four columns at a time: each column's products in 4 lanes over the rows (a
+ * multiple of 4), the four columns' lanes summed together in two rounds of shuffles, the rows
+ * after the last multiple of 4 added in order after that; a column left over likewise alone.
+ * Four accumulators of 4 doubles and the row vector leave AVX2's 16 registers room (eight of 8
+ * doubles did not, and spilled): at M = 27 to 120 a third to a sixth of their time. */
 FCM_MULTIVERSION_CLONES static void dgemv_t(int m, int n, const double *A, int lda, const double *x,
                                             double *y)
 {
+  const int m4 = m / 4 * 4;
+  const fit_v4i e = {0, 4, 2, 6}, o = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
   int j = 0;
-  for (; j + 8 <= n; j += 8)
-    dcols8(m, A + (size_t)j * (size_t)lda, lda, x, y + j);
+  for (; j + 4 <= n; j += 4) {
+    const double *a0 = A + (size_t)j * (size_t)lda, *a1 = a0 + lda, *a2 = a1 + lda, *a3 = a2 + lda;
+    fit_v4d c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, xv, v;
+    for (int r = 0; r < m4; r += 4) {
+      memcpy(&xv, x + r, sizeof xv);
+      memcpy(&v, a0 + r, sizeof v);
+      c0 += v * xv;
+      memcpy(&v, a1 + r, sizeof v);
+      c1 += v * xv;
+      memcpy(&v, a2 + r, sizeof v);
+      c2 += v * xv;
+      memcpy(&v, a3 + r, sizeof v);
+      c3 += v * xv;
+    }
+    const fit_v4d p0 = __builtin_shuffle(c0, c1, e) + __builtin_shuffle(c0, c1, o),
+                  p1 = __builtin_shuffle(c2, c3, e) + __builtin_shuffle(c2, c3, o),
+                  out = __builtin_shuffle(p0, p1, lo) + __builtin_shuffle(p0, p1, hi);
+    double t[4];
+    memcpy(t, &out, sizeof t);
+    for (int r = m4; r < m; r++)
+      t[0] += a0[r] * x[r], t[1] += a1[r] * x[r], t[2] += a2[r] * x[r], t[3] += a3[r] * x[r];
+    memcpy(y + j, t, sizeof t);
+  }
   for (; j < n; j++) {
     const double *a = A + (size_t)j * (size_t)lda;
-    double t = 0.0;
-    for (int r = 0; r < m; r++)
+    fit_v4d c = {0}, xv, v;
+    for (int r = 0; r < m4; r += 4) {
+      memcpy(&xv, x + r, sizeof xv);
+      memcpy(&v, a + r, sizeof v);
+      c += v * xv;
+    }
+    double t = (c[0] + c[1]) + (c[2] + c[3]);
+    for (int r = m4; r < m; r++)
       t += a[r] * x[r];
     y[j] = t;
   }
 }
 
-/* As dcols8() in single precision, rows in vectors of 16 (m a multiple of 16: the caller pads). */
-static inline __attribute__((always_inline)) void scols8(int m, const float *A, int lda,
-                                                         const float *x, float *y)
-{
-  fit_v16f c[8] = {{0}}, xv, a;
-  for (int r = 0; r < m; r += 16) {
-    memcpy(&xv, x + r, sizeof xv);
-    for (int j = 0; j < 8; j++) {
-      memcpy(&a, A + (size_t)j * (size_t)lda + r, sizeof a);
-      c[j] += a * xv;
-    }
-  }
-  fit_v8f h[8], out;
-  for (int j = 0; j < 8; j++) {
-    fit_v8f l, u;
-    memcpy(&l, &c[j], sizeof l);
-    memcpy(&u, (const float *)&c[j] + 8, sizeof u);
-    h[j] = l + u;
-  }
-  FIT_TREE(fit_v8f, fit_v8fi, h, out);
-  memcpy(y, &out, sizeof out);
-}
-
-FCM_MULTIVERSION_CLONES static void sgemv_t(int m, int n, const float *A, int lda, const float *x,
-                                            float *y)
+/* y[0..n) = sum over i of x[i] times row i of A (m x n, by rows, leading dimension ldr): the
+ * columns side by side in the vectors' lanes, 32 at a time, each lane the sum over the rows in
+ * their order. No lane is summed with another, so any vector width gives the scalar loop's bits;
+ * a call costs the multiply-adds alone (the gradient of a fit at M = 27: a fifth of a column-wise
+ * product's time, whose horizontal sums and register spills dominate at few rows). */
+FCM_MULTIVERSION_CLONES static void sgemv_rows(int m, int n, const float *A, int ldr,
+                                               const float *x, float *y)
 {
   int j = 0;
-  for (; j + 8 <= n; j += 8)
-    scols8(m, A + (size_t)j * (size_t)lda, lda, x, y + j);
+  for (; j + 32 <= n; j += 32) {
+    fit_v8f c0 = {0}, c1 = {0}, c2 = {0}, c3 = {0}, a0, a1, a2, a3;
+    for (int i = 0; i < m; i++) {
+      const float *a = A + (size_t)i * (size_t)ldr + j, t = x[i];
+      const fit_v8f xv = {t, t, t, t, t, t, t, t};
+      memcpy(&a0, a, sizeof a0);
+      memcpy(&a1, a + 8, sizeof a1);
+      memcpy(&a2, a + 16, sizeof a2);
+      memcpy(&a3, a + 24, sizeof a3);
+      c0 += a0 * xv, c1 += a1 * xv, c2 += a2 * xv, c3 += a3 * xv;
+    }
+    memcpy(y + j, &c0, sizeof c0);
+    memcpy(y + j + 8, &c1, sizeof c1);
+    memcpy(y + j + 16, &c2, sizeof c2);
+    memcpy(y + j + 24, &c3, sizeof c3);
+  }
+  for (; j + 8 <= n; j += 8) {
+    fit_v8f c0 = {0}, a0;
+    for (int i = 0; i < m; i++) {
+      const float t = x[i];
+      const fit_v8f xv = {t, t, t, t, t, t, t, t};
+      memcpy(&a0, A + (size_t)i * (size_t)ldr + j, sizeof a0);
+      c0 += a0 * xv;
+    }
+    memcpy(y + j, &c0, sizeof c0);
+  }
   for (; j < n; j++) {
-    const float *a = A + (size_t)j * (size_t)lda;
     float t = 0.0f;
-    for (int r = 0; r < m; r++)
-      t += a[r] * x[r];
+    for (int i = 0; i < m; i++)
+      t += A[(size_t)i * (size_t)ldr + j] * x[i];
     y[j] = t;
   }
 }
@@ -119,9 +113,9 @@ void fcm__fit_dgemv_t(int m, int n, const double *A, int lda, const double *x, d
   dgemv_t(m, n, A, lda, x, y);
 }
 
-void fcm__fit_sgemv_t(int m, int n, const float *A, int lda, const float *x, float *y)
+void fcm__fit_sgemv_rows(int m, int n, const float *A, int ldr, const float *x, float *y)
 {
-  sgemv_t(m, n, A, lda, x, y);
+  sgemv_rows(m, n, A, ldr, x, y);
 }
 #else
 void fcm__fit_dgemv_t(int m, int n, const double *A, int lda, const double *x, double *y)
@@ -134,12 +128,12 @@ void fcm__fit_dgemv_t(int m, int n, const double *A, int lda, const double *x, d
   }
 }
 
-void fcm__fit_sgemv_t(int m, int n, const float *A, int lda, const float *x, float *y)
+void fcm__fit_sgemv_rows(int m, int n, const float *A, int ldr, const float *x, float *y)
 {
   for (int j = 0; j < n; j++) {
     float t = 0.0f;
-    for (int r = 0; r < m; r++)
-      t += A[(size_t)j * (size_t)lda + r] * x[r];
+    for (int i = 0; i < m; i++)
+      t += A[(size_t)i * (size_t)ldr + j] * x[i];
     y[j] = t;
   }
 }

@@ -250,10 +250,11 @@ static inline double fcm__fit_dot(int n, const double *x, const double *y)
  * running maximum gives, NaNs left out. */
 double fcm__nnls_top_cosine(int k, const double *g, const double *inv, const int *pas, int it);
 
-/* y = A^T x for A (m x n, column-major, leading dimension lda): NNLS's products
- * (fit_kernels.c). The single-precision one needs m a multiple of 16 (rows padded with zeros). */
+/* y = A^T x for A m x n: NNLS's products (fit_kernels.c). fcm__fit_dgemv_t() takes A
+ * column-major (leading dimension lda), fcm__fit_sgemv_rows() by rows (row i at A + i ldr),
+ * each y_j then the sum over the rows in their order, as the plain loop gives it bit for bit. */
 void fcm__fit_dgemv_t(int m, int n, const double *A, int lda, const double *x, double *y);
-void fcm__fit_sgemv_t(int m, int n, const float *A, int lda, const float *x, float *y);
+void fcm__fit_sgemv_rows(int m, int n, const float *A, int ldr, const float *x, float *y);
 
 /* Non-negative least squares min ||A x - b||_2, x >= 0 (Lawson and Hanson's active set method
  * with the passive columns' QR factorization updated column by column): A is M x k (ld M), x
