@@ -19,8 +19,11 @@ typedef float fit_v8f __attribute__((vector_size(32)));
 /* y[0..n) = A^T x, four columns at a time: each column's products in 4 lanes over the rows (a
  * multiple of 4), the four columns' lanes summed together in two rounds of shuffles, the rows
  * after the last multiple of 4 added in order after that; a column left over likewise alone.
- * Four accumulators of 4 doubles and the row vector leave AVX2's 16 registers room (eight of 8
- * doubles did not, and spilled): at M = 27 to 120 a third to a sixth of their time. */
+ * Four accumulators of 4 doubles and the row vector fit AVX2's 16 vector registers without
+ * spilling, and two rounds of shuffles per four columns cost little against the products even
+ * at M = 27. The clones are static: a cloned function's dispatcher would otherwise be exported
+ * from the shared library whatever the visibility (the ifunc resolver keeps default
+ * visibility), so the module's entry points below only call them. */
 FCM_MULTIVERSION_CLONES static void dgemv_t(int m, int n, const double *A, int lda, const double *x,
                                             double *y)
 {
@@ -67,9 +70,9 @@ FCM_MULTIVERSION_CLONES static void dgemv_t(int m, int n, const double *A, int l
 
 /* y[0..n) = sum over i of x[i] times row i of A (m x n, by rows, leading dimension ldr): the
  * columns side by side in the vectors' lanes, 32 at a time, each lane the sum over the rows in
- * their order. No lane is summed with another, so any vector width gives the scalar loop's bits;
- * a call costs the multiply-adds alone (the gradient of a fit at M = 27: a fifth of a column-wise
- * product's time, whose horizontal sums and register spills dominate at few rows). */
+ * their order. No lane is summed with another, so any vector width gives the scalar loop's bits,
+ * and a call costs the multiply-adds alone: no horizontal sums, which at few rows would cost as
+ * much as the products. */
 FCM_MULTIVERSION_CLONES static void sgemv_rows(int m, int n, const float *A, int ldr,
                                                const float *x, float *y)
 {
