@@ -9,7 +9,8 @@
  *  - the force is the energy's gradient (central differences at a deformed state) and the
  *    tangent is the force's derivative, at a rigidly rotated state and at a deformed and
  *    rotated one (the exact Hessian); there the PSD tangent (project_psd, the warped
- *    R K R^T) is positive semi-definite and misses the rotation terms;
+ *    R K R^T) is positive semi-definite and misses the rotation terms; both are exactly
+ *    symmetric;
  *  - the element matrices are kept: later assemblies build none, until the Lame parameters
  *    change.
  * Usage: fem_corot_linear <element> */
@@ -203,6 +204,9 @@ static void check_space(fcm_space *space, const fcm_mesh *mesh)
     const double scale = max_abs(n, Ku);
     printf("exact tangent, deformed: |T du - FD| / |T du| = %.3g\n", diff / scale);
     TEST_TRUE(diff <= 1e-6 * scale);
+    double asym = 1.0;
+    TEST_OK(ctx, fcm_csr_asymmetry(T, &asym));
+    TEST_TRUE(asym == 0.0);
     fcm_material_params pp = p;
     pp.project_psd = 1;
     eval(ws, &pp, x, f, T, n);
@@ -212,6 +216,8 @@ static void check_space(fcm_space *space, const fcm_mesh *mesh)
       miss = fmax(miss, fabs(fp[i] - Ku[i]));
     printf("PSD tangent, deformed: |T du - FD| / |T du| = %.3g\n", miss / max_abs(n, Ku));
     TEST_TRUE(miss >= 1e-3 * max_abs(n, Ku));
+    TEST_OK(ctx, fcm_csr_asymmetry(T, &asym));
+    TEST_TRUE(asym == 0.0);
     for (int k = 0; k < 5; k++) {
       for (fcm_index i = 0; i < n; i++)
         dv[i] = urand(&seed) - 0.5;

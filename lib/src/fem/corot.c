@@ -279,6 +279,7 @@ cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const dou
   if (kd->want_tangent) {
     warp_blocks(nn, Kp, R, w->Ke);
     if (kd->corot_exact) add_rotation_terms(nn, Kp, gbar, &pr, y, Kd, z, w->Ke);
+    fcm__kernel_symmetrize(nn, w->Ke);
   }
   if (kd->want_force) {
     for (int a = 0; a < nn; a++) {

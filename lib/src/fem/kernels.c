@@ -599,20 +599,35 @@ static cell_result hyperelastic_kernel(const kernel_data *kd, const cell_rule *r
   return res;
 }
 
+void fcm__kernel_symmetrize(int nn, double *Kp)
+{
+  for (int a = 0; a < nn; a++) {
+    const double k01 = 0.5 * (Kp[1] + Kp[3]), k02 = 0.5 * (Kp[2] + Kp[6]);
+    const double k12 = 0.5 * (Kp[5] + Kp[7]);
+    Kp[1] = Kp[3] = k01, Kp[2] = Kp[6] = k02, Kp[5] = Kp[7] = k12;
+    Kp += 9 * (nn - a); /* past blocks (a, a..nn) to (a + 1, a + 1) */
+  }
+}
+
 cell_result fcm__cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w)
 {
+  cell_result res;
   switch (kd->kind) {
   case KERNEL_STIFFNESS:
     memset(w->fe, 0, sizeof *w->fe * (size_t)(3 * nn));
-    return stiffness_kernel(kd, r, nn, w);
+    res = stiffness_kernel(kd, r, nn, w);
+    break;
   case KERNEL_MASS:
     memset(w->fe, 0, sizeof *w->fe * (size_t)(3 * nn));
     return mass_kernel(kd, r, nn, w);
   case KERNEL_BODY_FORCE:
     return body_force_kernel(kd, r, nn, w);
   default:
-    return hyperelastic_kernel(kd, r, nn, w);
+    res = hyperelastic_kernel(kd, r, nn, w);
+    if (!kd->want_tangent) return res;
   }
+  fcm__kernel_symmetrize(nn, w->Ke);
+  return res;
 }
 
 void fcm__kernel_unpack(int nn, const double *Kp, double *Ke)

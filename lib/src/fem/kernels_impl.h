@@ -115,7 +115,8 @@ void fcm__kernel_scratch_init(int nn, size_t mq, double *mem, scratch *w);
  * (and displacement w->ue): the kernel of the integrand. The element matrices are symmetric:
  * w->Ke holds their upper node blocks, block (a, b) for a <= b (row-major 3 x 3, entry [3i + j]
  * = K_(a,i)(b,j)) at 9 (a nn - a (a - 1) / 2 + b - a), in the order of a, then b
- * (fcm__kernel_unpack() spreads them into the full matrix). fe is zero after a matrix kernel.
+ * (fcm__kernel_unpack() spreads them into the full matrix); the diagonal blocks are exactly
+ * symmetric (fcm__kernel_symmetrize()). fe is zero after a matrix kernel.
  * Built for several instruction sets, selected at run time. */
 cell_result fcm__cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, scratch *w);
 
@@ -125,6 +126,12 @@ cell_result fcm__cell_kernel(const kernel_data *kd, const cell_rule *r, int nn, 
  * the mean physical gradients gbar (nn x 3) of its shape functions over its material. */
 cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const double *gbar, int nn,
                               scratch *w);
+
+/* Make the diagonal node blocks (a, a) of the upper node blocks Kp exactly symmetric: each pair
+ * of entries (i, j), (j, i) becomes their mean. The kernels sum K_(a,i)(a,j) and K_(a,j)(a,i) in
+ * different orders (and the compiler may fuse different products), so the two differ in the last
+ * bits; a symmetric matrix's values must not, since solvers read one triangle or both. */
+void fcm__kernel_symmetrize(int nn, double *Kp);
 
 /* The full element matrix Ke (3nn x 3nn, row-major) from its upper node blocks Kp. */
 void fcm__kernel_unpack(int nn, const double *Kp, double *Ke);

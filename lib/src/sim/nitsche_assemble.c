@@ -27,10 +27,10 @@ void fcm__sim_scatter(const fcm_space *s, fcm_index le, const double *Ke, double
   for (int a = 0; a < nn; a++)
     for (int i = 0; i < 3; i++) {
       double *dst = vals + s->row_ptr[fcm__space_elem_row(s, le, a) + i];
-      const double *src = Ke + (size_t)(3 * a + i) * nd;
+      const double *src = Ke + (size_t)(3 * a + i) * nd, *col = Ke + 3 * a + i;
       for (int b = 0; b < nn; b++)
         for (int k = 0; k < 3; k++)
-          dst[3 * off[a * nn + b] + k] += src[3 * b + k];
+          dst[3 * off[a * nn + b] + k] += 0.5 * (src[3 * b + k] + col[(size_t)(3 * b + k) * nd]);
     }
 }
 

@@ -456,9 +456,12 @@ int fcm__sim_boundary_time(fcm_integrator *I, double t);
 fcm_status fcm__sim_boundary_assemble(fcm_integrator *I, const double *x, int projected,
                                       double *energy, double *force, fcm_csr *T, int *finite);
 
-/* Add the element matrix Ke (3nn x 3nn) of the element at local position le into the values
- * of the pattern (a matrix over the space's rows, fcm__space_matrix_create_rows()).
- * (nitsche.c) */
+/* Add the symmetric part (Ke + Ke^T) / 2 of the element matrix Ke (3nn x 3nn) of the element
+ * at local position le into the values of the pattern (a matrix over the space's rows,
+ * fcm__space_matrix_create_rows()). The boundary and contact terms are symmetric, but their
+ * entries (i, j) and (j, i) are computed in different orders and differ in the last bits; the
+ * matrix's values must be exactly symmetric, since solvers read one triangle or both.
+ * (nitsche_assemble.c) */
 void fcm__sim_scatter(const fcm_space *s, fcm_index le, const double *Ke, double *vals);
 /* FCM_ERR_ARG (named after `who`) unless T (may be NULL) has the space's matrix pattern.
  * (nitsche.c) */
