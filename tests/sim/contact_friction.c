@@ -4,7 +4,8 @@
  *              differences): with the lagged normal forces and tangents fixed (taken at a random
  *              start state), central differences of the energy match the force and those of the
  *              force the Newton matrix (relative error <= 1e-6), at slips both inside and beyond
- *              the smoothing band; the friction's energy is positive and the matrix exactly symmetric
+ *              the smoothing band; the friction's energy is positive and the matrix exactly
+ *              symmetric
  *   incline <mu>  a block (0.6 x 0.6 x 0.2 m, E = 1e6 Pa) resting on a floor under gravity
  *              tilted by theta = 20 degrees (tan theta = 0.364), backward Euler dt 0.01 s:
  *              with mu = 0.6 > tan theta it stays: its centre of mass moves along the slope by at
