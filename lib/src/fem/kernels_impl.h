@@ -128,9 +128,11 @@ cell_result fcm__corot_kernel(const kernel_data *kd, const double *Kp, const dou
                               scratch *w);
 
 /* Make the diagonal node blocks (a, a) of the upper node blocks Kp exactly symmetric: each pair
- * of entries (i, j), (j, i) becomes their mean. The kernels sum K_(a,i)(a,j) and K_(a,j)(a,i) in
- * different orders (and the compiler may fuse different products), so the two differ in the last
- * bits; a symmetric matrix's values must not, since solvers read one triangle or both. */
+ * of entries (i, j), (j, i) becomes their mean. The kernels compute K_(a,i)(a,j) and
+ * K_(a,j)(a,i) apart: the compiler fuses different products of the two (kernels.c is built with
+ * -ffp-contract=fast), and the hyperelastic and corotated kernels sum them in different orders,
+ * so the two can differ in the last bits; a symmetric matrix's values must not, since solvers
+ * read one triangle or both. */
 void fcm__kernel_symmetrize(int nn, double *Kp);
 
 /* The full element matrix Ke (3nn x 3nn, row-major) from its upper node blocks Kp. */
