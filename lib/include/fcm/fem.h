@@ -324,7 +324,8 @@ FCM_API fcm_status fcm_assembly_workspace_hyperelastic(fcm_assembly_workspace *w
  * FCM_LINEAR_STIFFNESS through a workspace made for this call. `mat` is validated
  * (fcm_material_validate()); its model is not used: the stiffness, mass and body force
  * here are those of linear elasticity with the material's E, nu and density. Bitwise
- * independent of the number of threads. @return FCM_OK, FCM_ERR_ARG (bad material, wrong matrix),
+ * independent of the number of threads; the values added are exactly symmetric (entry (i, j)
+ * equals entry (j, i) bit for bit). @return FCM_OK, FCM_ERR_ARG (bad material, wrong matrix),
  * FCM_ERR_GEOMETRY (det J <= 0 at a quadrature point: the message names the cell),
  * FCM_ERR_ALLOC. Allocates a workspace; for repeated assembly keep one. */
 FCM_API fcm_status fcm_assemble_stiffness(const fcm_space *space, const fcm_material *mat,
@@ -365,7 +366,8 @@ FCM_API fcm_status fcm_assemble_surface_traction(const fcm_space *space, fcm_fie
  * @param[out] energy  may be NULL; @param[in,out] force may be NULL; tangent may be NULL
  * @return FCM_OK, FCM_ERR_ARG, FCM_ERR_NUMERIC (the material gave NaN/Inf: the
  * message names the cell), FCM_ERR_GEOMETRY, FCM_ERR_ALLOC. Deterministic for any
- * number of threads (energy summed per cell in cell order). */
+ * number of threads (energy summed per cell in cell order); the tangent's values are exactly
+ * symmetric, as the stiffness's. */
 FCM_API fcm_status fcm_assemble_hyperelastic(const fcm_space *space, const fcm_material_params *mat,
                                              const double *u, const fcm_assembly_options *opts,
                                              double *energy, double *force, fcm_csr *tangent);
