@@ -10,7 +10,9 @@
  *   drop <scheme>  a Hex8 ball dropped under gravity onto a floor: no surface point ever at
  *              or below the floor; backward Euler: it comes to rest (centre-of-mass velocity
  *              small) and the floor's reaction is m g within 3 %; Newmark: it bounces (the
- *              centre of mass moves up after the impact)
+ *              centre of mass moves up after the impact); after every step the Newton
+ *              matrix (mass, Stable Neo-Hookean tangent, barrier, eliminated rows) is exactly
+ *              symmetric
  *   iterates   a ball dropped onto a floor with Newmark (it bounces), Newton limited to 6
  *              iterations so that the impact's steps are halved into substeps: every Newton
  *              iterate (seen by the monitor) keeps every point in front of the floor, and each
@@ -26,6 +28,7 @@
  *              and so is the block on the floor alone (2 translations and 1 rotation free) */
 #include "sim_util.h"
 #include "fcm/fcm.h"
+#include "sim/sim_impl.h"
 #include "test.h"
 
 #include <math.h>
@@ -168,6 +171,10 @@ static int drop(fcm_ctx *ctx, fcm_time_scheme scheme, int argc_steps)
     fcm_step_info info;
     double dmin = 0.0;
     TEST_OK(ctx, fcm_integrator_step(I, &info));
+    double asym = 1.0;
+    TEST_TRUE(I->H != NULL);
+    TEST_OK(ctx, fcm_csr_asymmetry(I->H, &asym));
+    if (!(asym == 0.0)) TEST_FAIL_("drop: step %d: Newton matrix asymmetry %.3g", s, asym);
     TEST_OK(ctx, fcm_integrator_contact_info(I, 0, F, &dmin, NULL, NULL));
     dmin_all = fmin(dmin_all, dmin);
     vcom = com_velocity(I, n, ez, w, &mass);
