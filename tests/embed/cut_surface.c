@@ -4,11 +4,15 @@
  * many pieces, the pieces match one to one, and each matched pair integrates every monomial of
  * reference coordinates up to the rule's strength alike to TOL of the reference cell's volume
  * (both rules are exact for those moments up to their fits' residuals); the pieces form as
- * many material components along the links. Knives: a tilted plane through the whole body (its
+ * many material components along the links, and matched pieces have the same cut faces (area,
+ * vector area, first moment of area to FACE_TOL): a cut face ends at the body's surface on
+ * both paths. Knives: a tilted plane through the whole body (its
  * edges run outside the body in cells the body reaches: material must not join around them), a
  * rectangle ending inside the body (a crack), a V of two half-planes (non-planar) and a second
  * plane crossing the first one in cells it already split, a square cutting off a cap of the
- * ball whose edges end outside the ball in cells that hold material on both sides. Hex8 and Tet4
+ * ball whose edges end outside the ball in cells that hold material on both sides, and a
+ * square in the air beside the ball, in cells its surface crosses (no cell integrated again,
+ * no cut face added). Hex8 and Tet4
  * backgrounds (argument "quadratic": Hex20 and Tet10). A U-shaped body of tets (two prongs
  * joined by a base) whose two prongs lie in one background cell, apart there, is cut across
  * both prongs: the part of the cell beyond the cut holds two separate lumps of the body, which
@@ -25,6 +29,11 @@ static fcm_ctx *ctx;
  * both paths reach 1e-14 relative residual of their moments (set below), the surface moments'
  * rounding is about 1e-15. */
 #define TOL 1e-12
+
+/* Agreement of matched pieces' cut faces (area, vector area, first moment of area), relative
+ * to the reference cell's volume: both are exact polygons of the same body, split at the
+ * cuts' tolerance (1e-9 of the cell size). */
+#define FACE_TOL 1e-8
 
 enum { MAX_M = 455 }; /* monomials of degree <= 12 */
 
@@ -67,8 +76,32 @@ static int components(const fcm_mesh *mesh, const fcm_cell_rules *r)
   return k;
 }
 
+/* The cut faces of piece p (reference coordinates): their area, vector area and first moment
+ * of area, f[0], f[1 .. 3], f[4 .. 6]. */
+static void face_moments(const fcm_cell_rules *r, fcm_index p, double f[7])
+{
+  const double *xi = NULL;
+  const fcm_index n = fcm_cell_rules_get_piece_cut_faces(r, p, &xi);
+  memset(f, 0, 7 * sizeof *f);
+  for (fcm_index t = 0; t < n; t++) {
+    const double *a = xi + 9 * t, *b = a + 3, *c = a + 6;
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                 v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {0.5 * (u[1] * v[2] - u[2] * v[1]), 0.5 * (u[2] * v[0] - u[0] * v[2]),
+                         0.5 * (u[0] * v[1] - u[1] * v[0])};
+    const double area = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    f[0] += area;
+    for (int d = 0; d < 3; d++) {
+      f[1 + d] += w[d];
+      f[4 + d] += area * (a[d] + b[d] + c[d]) / 3.0;
+    }
+  }
+}
+
 /* The rules of the volume path (rv) and the surface path (rs) agree; returns the largest
- * moment difference relative to the reference cell's volume. */
+ * moment difference relative to the reference cell's volume. The pieces' cut faces agree too:
+ * the volume path's are the faces of its parts clipped to the body's tets, the surface path's
+ * the faces of its parts (which reach beyond the body) cut down to the body. */
 static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_cell_rules *rs,
                       const char *what)
 {
@@ -87,6 +120,7 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
       const int m = fcm_cell_rules_strength(rv, (fcm_rule_kind)k);
       TEST_TRUE((m + 1) * (m + 2) * (m + 3) / 6 <= MAX_M);
       unsigned char used[64] = {0};
+      int match[64];
       for (fcm_index p = fv; p < fv + kv; p++) {
         const int M = piece_monomials(ctx, rv, p, (fcm_rule_kind)k, m, mv);
         double best = HUGE_VAL;
@@ -100,12 +134,25 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
           if (d < best) best = d, bq = (int)q;
         }
         if (bq >= 0) used[bq] = 1;
+        if (p - fv < 64) match[p - fv] = bq;
         worst = fmax(worst, best);
         TEST_TRUE_MSG(best <= TOL,
                       "%s: cell %lld piece %lld (%s): moments differ by %.3g of the "
                       "reference volume",
                       what, (long long)c, (long long)(p - fv),
                       k == FCM_RULE_MASS ? "mass" : "stiffness", best);
+      }
+      for (fcm_index p = fv; k == FCM_RULE_MASS && p < fv + kv && p - fv < 64; p++) {
+        if (match[p - fv] < 0) continue;
+        double a[7], b[7], d = 0.0;
+        face_moments(rv, p, a);
+        face_moments(rs, fs + match[p - fv], b);
+        for (int i = 0; i < 7; i++)
+          d = fmax(d, fabs(a[i] - b[i]));
+        TEST_TRUE_MSG(d <= FACE_TOL * vref,
+                      "%s: cell %lld piece %lld: cut faces differ by %.3g (area %.6g on the "
+                      "volume path, %.6g on the surface)",
+                      what, (long long)c, (long long)(p - fv), d, a[0], b[0]);
       }
     }
   }
@@ -145,7 +192,7 @@ static void run(fcm_element_type type)
   o.simplify_options.residual_tol = 1e-14;
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gv, &o, &rv));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gs, &o, &rs));
-  fcm_surface *knife[5] = {NULL, NULL, NULL, NULL, NULL};
+  fcm_surface *knife[6] = {NULL, NULL, NULL, NULL, NULL, NULL};
   const double p0[3] = {0.13, 0.05, -0.02}, n0[3] = {1, 0.3, 0.2};
   const double blo[3] = {-1.05, -1.05, -1.05}, bhi[3] = {1.05, 1.05, 1.05};
   TEST_OK(ctx, fcm_surface_create_plane(ctx, p0, n0, blo, bhi, &knife[0]));
@@ -160,8 +207,16 @@ static void run(fcm_element_type type)
   const double qc[3] = {0.02, -0.03, 0.8}, qn[3] = {0.05, 0.02, 1}, qa[3] = {1, 0.1, 0},
                qsz[2] = {1.4, 1.4};
   TEST_OK(ctx, fcm_surface_create_rectangle(ctx, qc, qn, qa, qsz, &knife[4]));
-  const char *names[5] = {"plane", "crack", "V", "crossing plane", "cap"};
-  for (int k = 0; k < 5; k++) {
+  /* a square in the air beside the ball (|x| > 1.1 on it) in cells the ball's surface
+   * crosses: it splits their parts, but gives no piece a face (the body is not there) */
+  const double ac[3] = {0.78, 0.78, -0.27}, an[3] = {1, 1, 0}, aa[3] = {0, 0, 1},
+               asz[2] = {0.2, 0.2};
+  TEST_OK(ctx, fcm_surface_create_rectangle(ctx, ac, an, aa, asz, &knife[5]));
+  const char *names[6] = {"plane", "crack", "V", "crossing plane", "cap", "square in the air"};
+  for (int k = 0; k < 6; k++) {
+    fcm_index faces_before = 0, faces_after = 0;
+    for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(rs); p++)
+      faces_before += fcm_cell_rules_get_piece_cut_faces(rs, p, NULL);
     fcm_cell_rules *nv = NULL, *ns = NULL;
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gv, rv, knife[k], &nv));
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gs, rs, knife[k], &ns));
@@ -172,12 +227,19 @@ static void run(fcm_element_type type)
     snprintf(what, sizeof what, "%s, %s", name, names[k]);
     const double worst = compare(mesh, rv, rs, what);
     const fcm_cell_rules_stats *S = fcm_cell_rules_get_stats(rs);
+    for (fcm_index p = 0; p < fcm_cell_rules_num_pieces(rs); p++)
+      faces_after += fcm_cell_rules_get_piece_cut_faces(rs, p, NULL);
+    if (k == 5)
+      TEST_TRUE_MSG(S->num_integrated == 0 && faces_after == faces_before,
+                    "%s: %lld cells integrated again, %lld cut-face triangles before, %lld after",
+                    what, (long long)S->num_integrated, (long long)faces_before,
+                    (long long)faces_after);
     printf("%s: %lld pieces, %d components, %lld cells fitted on surface moments (%lld pieces "
            "split by the boundary instead), moments agree to %.2e of |K_ref|\n",
            what, (long long)fcm_cell_rules_num_pieces(rs), components(mesh, rs),
            (long long)S->num_surface_cells, (long long)S->num_surface_fallbacks, worst);
   }
-  for (int k = 0; k < 5; k++)
+  for (int k = 0; k < 6; k++)
     fcm_surface_destroy(&knife[k]);
   fcm_cell_rules_destroy(&rv);
   fcm_cell_rules_destroy(&rs);

@@ -304,37 +304,51 @@ cleanup:
   return st;
 }
 
+fcm_status fcm__embed_tris_fan(fcm_ctx *ctx, fcm__tribuf *b, const double *x, int m)
+{
+  fcm_status st = FCM_OK;
+  if (m < 3) return FCM_OK;
+  if (b->n + m - 2 > b->cap) {
+    const int cap = FCM_MAX(2 * b->cap, b->n + m - 2 + 16);
+    void *v = b->t;
+    FCM_TRY(ctx, fcm__resize(ctx, &v, 9 * (size_t)b->n, 9 * (size_t)cap, sizeof(double)));
+    b->t = v;
+    b->cap = cap;
+  }
+  for (int k = 1; k + 1 < m; k++, b->n++) {
+    double *t = b->t + 9 * (size_t)b->n;
+    memcpy(t, x, 3 * sizeof *t);
+    memcpy(t + 3, x + 3 * k, 3 * sizeof *t);
+    memcpy(t + 6, x + 3 * (k + 1), 3 * sizeof *t);
+  }
+cleanup:
+  return st;
+}
+
 fcm_status fcm__embed_cut_faces(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
                                 const fcm__parts *P, int piece, double **tri, int *ntri)
 {
   fcm_status st = FCM_OK;
   const double mtol = MATCH_RTOL * cell->size;
   double x[3 * FCM__POLY_MAX_FV];
-  int n = 0, cap = 0;
-  double *t = NULL;
+  fcm__tribuf b = {NULL, 0, 0};
   for (size_t i = 0; i < P->n; i++) {
     if (P->piece[i] != piece) continue;
     const fcm__poly *q = P->poly + i;
+    /* a part the body does not fill may reach beyond it: its faces' part inside the body */
+    const int clip = P->mat && !fcm__embed_part_full(P, i);
     for (int f = 0; f < q->nf; f++) {
       const int m = fcm__embed_face_coords(q, f, x);
       if (!fcm__embed_on_cut(tris, P->tcand.ids, P->tcand.n, x, m, mtol)) continue;
-      if (n + m - 2 > cap) {
-        const int ncap = FCM_MAX(2 * cap, n + m - 2 + 16);
-        void *v = t;
-        FCM_TRY(ctx, fcm__resize(ctx, &v, 9 * (size_t)n, 9 * (size_t)ncap, sizeof(double)));
-        t = v;
-        cap = ncap;
-      }
-      for (int k = 1; k + 1 < m; k++, n++) { /* fan: the face's own orientation (outward) */
-        memcpy(t + 9 * n, x, 3 * sizeof *t);
-        memcpy(t + 9 * n + 3, x + 3 * k, 3 * sizeof *t);
-        memcpy(t + 9 * n + 6, x + 3 * (k + 1), 3 * sizeof *t);
-      }
+      if (clip)
+        FCM_TRY(ctx, fcm__material_face_inside(ctx, P->mat, cell, x, m, &b));
+      else
+        FCM_TRY(ctx, fcm__embed_tris_fan(ctx, &b, x, m)); /* the face's orientation (outward) */
     }
   }
-  *tri = t, *ntri = n;
-  t = NULL;
+  *tri = b.t, *ntri = b.n;
+  b.t = NULL;
 cleanup:
-  fcm__free(ctx, t);
+  fcm__free(ctx, b.t);
   return st;
 }

@@ -500,9 +500,20 @@ fcm_status fcm__embed_finder_point(fcm__embed_finder *f, fcm_index c, const doub
 fcm_status fcm__embed_finder_clip(fcm__embed_finder *f, fcm_index c, const double x[9],
                                   fcm__embed_polys *out);
 
+/* Triangles, 9 doubles each (3 vertices), grown as they are appended. */
+typedef struct fcm__tribuf {
+  double *t;
+  int n, cap;
+} fcm__tribuf;
+
+/* Append the fan of the polygon x (m vertices) to b, with x's orientation. */
+fcm_status fcm__embed_tris_fan(fcm_ctx *ctx, fcm__tribuf *b, const double *x, int m);
+
 /* The faces of `piece`'s parts that lie on a cut triangle (the piece's side of the cuts),
  * fan-triangulated with their outward orientation: *tri (allocated, 9 doubles = 3 physical
- * vertices per triangle; NULL when none) and *ntri. */
+ * vertices per triangle; NULL when none) and *ntri. On a body given by its surface (P->mat),
+ * the part of each such face inside the body (fcm__material_face_inside()) where the body does
+ * not fill the part: a cut face does not reach beyond the body. */
 fcm_status fcm__embed_cut_faces(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
                                 const fcm__parts *P, int piece, double **tri, int *ntri);
 
@@ -803,6 +814,14 @@ fcm_status fcm__material_poly(fcm_ctx *ctx, fcm__material *m, const fcm__poly *p
  * then 1. */
 int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
                           const double *x, int n, const double nrm[3], double h, double atol);
+
+/* The part of the planar convex polygon x (n vertices, physical) on a face of cell inside the
+ * body, fanned into b with x's orientation: x is split along the lines where the boundary
+ * triangles near it cross its plane, into convex polygons that no boundary crosses, and those
+ * the body holds (an inside test at each one's vertex centroid) are kept. Polygons of no
+ * more area than 1e-9 of the cell size squared are left out. */
+fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
+                                     const double *x, int n, fcm__tribuf *b);
 
 /* The first error fcm__material_on_face() kept (FCM_OK: none), cleared. */
 fcm_status fcm__material_status(fcm__material *m);
