@@ -2,7 +2,10 @@
  * mesh: with "volume_mesh" "auto" the set-up skips Gmsh (its phase takes no time), the cut
  * cells' pieces are fitted on surface moments, and after a tilted plane cut and three steps
  * under gravity the DOFs, the centre of mass and the largest displacement equal those of the
- * volume path ("volume_mesh": true, "moments": "volume", when fcm has Gmsh) to CTOL and UTOL. */
+ * volume path ("volume_mesh": true, "moments": "volume", when fcm has Gmsh) to CTOL and UTOL.
+ * On both paths a blade in the air beside the ball, in cells the ball's surface crosses, then
+ * misses: the run keeps its rules and integrator (the surface path's cut faces end at the
+ * body, so the blade gives the pieces none). */
 #define _POSIX_C_SOURCE 200809L
 #include "fcm/embed.h"
 #include "fcm/fem.h"
@@ -93,6 +96,22 @@ static int run(const char *dir, const char *geometry, const char *quadrature, do
     TEST_OK(ctx, fcm_simulation_center_of_mass(sim, com));
     TEST_OK(ctx, fcm_space_max_displacement(
                      space, fcm_integrator_displacement(fcm_simulation_integrator(sim)), umax));
+    /* a square in the air beside the ball (|x| > 1.1 on it), in cells the ball's surface
+     * crosses: it meets no material, so the run keeps its rules and integrator */
+    const double ac[3] = {0.78, 0.78, -0.27}, an[3] = {1, 1, 0}, aa[3] = {0, 0, 1},
+                 asz[2] = {0.2, 0.2};
+    fcm_surface *air = NULL;
+    fcm_cut_info info;
+    const fcm_integrator *I = fcm_simulation_integrator(sim);
+    const fcm_cell_rules *R = fcm_simulation_cell_rules(sim);
+    TEST_OK(ctx, fcm_surface_create_rectangle(ctx, ac, an, aa, asz, &air));
+    TEST_OK(ctx, fcm_simulation_cut(sim, air, FCM_CUT_FRAME_REFERENCE, &info));
+    if (!(info.missed && info.cells_integrated == 0 && fcm_simulation_integrator(sim) == I &&
+          fcm_simulation_cell_rules(sim) == R))
+      TEST_FAIL_("a blade in the air: missed %d, %lld cells integrated again, integrator %s",
+                 info.missed, (long long)info.cells_integrated,
+                 fcm_simulation_integrator(sim) == I ? "kept" : "made again");
+    fcm_surface_destroy(&air);
   }
   fcm_simulation_destroy(&sim);
   fcm_scene_destroy(&scene);

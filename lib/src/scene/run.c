@@ -554,7 +554,8 @@ cleanup:
  * blade then divides no part, now or after later cuts (their parts lie in these), so the run's
  * rules, space and integrator serve as they are, and its next steps are those it would have
  * taken without the cut, bit for bit. (On a body given by its surface alone a cell's parts
- * include its empty part: a blade through it gives faces, and the run is made again.) */
+ * include its empty part; a blade through it alone splits them, but the pieces' cut faces end
+ * at the body, so it gives none.) */
 static int unchanged(const fcm_simulation *S, const fcm_cell_rules *rules)
 {
   const fcm_cell_rules *old = S->rules;
