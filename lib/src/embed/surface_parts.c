@@ -623,7 +623,8 @@ fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__
   const double tol = FCM__EMBED_MATCH_RTOL * cell->size,
                amin = FACE_AREA_RTOL * cell->size * cell->size;
   double nrm[3] = {0.0, 0.0, 0.0}, lo[3], hi[3], work[SLOT];
-  if (n < 3 || n > FCM__POLY_MAX_VERTS) return FCM_OK;
+  if (n < 3) return FCM_OK;
+  if (n > FCM__POLY_MAX_VERTS) return fcm__embed_tris_fan(ctx, b, x, n); /* beyond a slot */
   for (int i = 0; i < n; i++) { /* Newell's normal: x's own orientation */
     const double *a = x + 3 * i, *c = x + 3 * ((i + 1) % n);
     nrm[0] += (a[1] - c[1]) * (a[2] + c[2]);
@@ -678,7 +679,10 @@ fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__
       memcpy(z, y, 3 * (size_t)m->fpn[j] * sizeof *y);
       const int a = fcm__geom_polygon_clip(y, m->fpn[j], FCM__POLY_MAX_VERTS, &pl, tol, 0, work);
       const int c = fcm__geom_polygon_clip(z, m->fpn[j], FCM__POLY_MAX_VERTS, &opp, tol, 0, work);
-      if (a < 3 || c < 3) { /* no split after all (or a slot's capacity): undo */
+      /* no split after all (or a slot's capacity): a clip that left fewer than 3 vertices
+       * did not touch its polygon, so y is whole, or z still holds it */
+      if (a < 3) continue;
+      if (c < 3) {
         memcpy(y, z, 3 * (size_t)m->fpn[j] * sizeof *y);
         continue;
       }
