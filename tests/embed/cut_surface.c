@@ -6,7 +6,8 @@
  * (both rules are exact for those moments up to their fits' residuals); the pieces form as
  * many material components along the links, and matched pieces have the same cut faces (area,
  * vector area, first moment of area to FACE_TOL): a cut face ends at the body's surface on
- * both paths. Knives: a tilted plane through the whole body (its
+ * both paths, and the links between pieces of neighbouring cells join the matched pieces alike.
+ * Knives: a tilted plane through the whole body (its
  * edges run outside the body in cells the body reaches: material must not join around them), a
  * rectangle ending inside the body (a crack), a V of two half-planes (non-planar) and a second
  * plane crossing the first one in cells it already split, a square cutting off a cap of the
@@ -16,7 +17,10 @@
  * backgrounds (argument "quadratic": Hex20 and Tet10). A U-shaped body of tets (two prongs
  * joined by a base) whose two prongs lie in one background cell, apart there, is cut across
  * both prongs: the part of the cell beyond the cut holds two separate lumps of the body, which
- * the volume path keeps as two pieces; so must the surface path. */
+ * the volume path keeps as two pieces; so must the surface path. A third plane, on the base's
+ * face between the prongs, cuts both prongs off the base there: the cell below it is cut again,
+ * the one above keeps its pieces (two lumps of one part), and their links must join each
+ * lump to its own prong; the cut face on the base's face belongs to the base alone. */
 #include "cut_util.h"
 
 #include <math.h>
@@ -105,6 +109,10 @@ static void face_moments(const fcm_cell_rules *r, fcm_index p, double f[7])
 static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_cell_rules *rs,
                       const char *what)
 {
+  const fcm_index npv = fcm_cell_rules_num_pieces(rv);
+  fcm_index *map = malloc(((size_t)npv + 1) * sizeof *map); /* volume piece -> surface piece */
+  for (fcm_index p = 0; p < npv; p++)
+    map[p] = -1;
   const fcm_element_type type = fcm_mesh_element_type(mesh);
   const double vref = type == FCM_ELEMENT_TET4 || type == FCM_ELEMENT_TET10 ? 1.0 / 6.0 : 8.0;
   double worst = 0.0, mv[MAX_M], ms[MAX_M];
@@ -135,6 +143,7 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
         }
         if (bq >= 0) used[bq] = 1;
         if (p - fv < 64) match[p - fv] = bq;
+        if (k == FCM_RULE_MASS && bq >= 0) map[p] = fs + bq;
         worst = fmax(worst, best);
         TEST_TRUE_MSG(best <= TOL,
                       "%s: cell %lld piece %lld (%s): moments differ by %.3g of the "
@@ -160,6 +169,25 @@ static double compare(const fcm_mesh *mesh, const fcm_cell_rules *rv, const fcm_
                 "%s: %d components on the volume "
                 "path, %d on the surface",
                 what, components(mesh, rv), components(mesh, rs));
+  /* the same links between the matched pieces */
+  const fcm_index nlv = fcm_cell_rules_num_links(rv), nls = fcm_cell_rules_num_links(rs);
+  const fcm_index *Lv = fcm_cell_rules_links(rv), *Ls = fcm_cell_rules_links(rs);
+  TEST_TRUE_MSG(nlv == nls, "%s: %lld links on the volume path, %lld on the surface", what,
+                (long long)nlv, (long long)nls);
+  for (fcm_index l = 0; l < nlv; l++) {
+    const fcm_index a = map[Lv[2 * l]], b = map[Lv[2 * l + 1]];
+    const fcm_index p = a < b ? a : b, q = a < b ? b : a;
+    int found = 0;
+    for (fcm_index m = 0; m < nls && !found && p >= 0; m++)
+      found = Ls[2 * m] == p && Ls[2 * m + 1] == q;
+    TEST_TRUE_MSG(found,
+                  "%s: the volume path links pieces %lld and %lld (cells %lld and %lld), the "
+                  "surface path not their matches",
+                  what, (long long)Lv[2 * l], (long long)Lv[2 * l + 1],
+                  (long long)fcm_cell_rules_piece_cell(rv, Lv[2 * l]),
+                  (long long)fcm_cell_rules_piece_cell(rv, Lv[2 * l + 1]));
+  }
+  free(map);
   return worst;
 }
 
@@ -292,15 +320,21 @@ static void run_u(fcm_element_type type)
   o.simplify_options.residual_tol = 1e-14;
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gv, &o, &rv));
   TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gs, &o, &rs));
-  fcm_surface *knife[2] = {NULL, NULL};
+  fcm_surface *knife[3] = {NULL, NULL, NULL};
   const double p0[3] = {1.5, 1.75, 0.5}, n0[3] = {-0.08, 1, 0.15};
   const double blo[3] = {-0.2, -0.2, -0.2}, bhi[3] = {3.2, 2.3, 1.2};
   TEST_OK(ctx, fcm_surface_create_plane(ctx, p0, n0, blo, bhi, &knife[0]));
   const double rc[3] = {0.6, 1.45, 0.5}, rn[3] = {0.05, 1, 0.1}, ra[3] = {1, 0, 0},
                rsz[2] = {1.8, 2.0};
   TEST_OK(ctx, fcm_surface_create_rectangle(ctx, rc, rn, ra, rsz, &knife[1]));
-  const char *names[2] = {"plane across both prongs", "crack across one prong"};
-  for (int k = 0; k < 2; k++) {
+  /* the plane y = 1.03 of the base's face between the prongs: the cell holds the base below
+   * it and the prongs above, and its cut face between the prongs lies on the body's surface,
+   * on the base's side only */
+  const double p2[3] = {1.5, 1.03, 0.5}, n2[3] = {0, 1, 0};
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p2, n2, blo, bhi, &knife[2]));
+  const char *names[3] = {"plane across both prongs", "crack across one prong",
+                          "plane on the base's face"};
+  for (int k = 0; k < 3; k++) {
     fcm_cell_rules *nv = NULL, *ns = NULL;
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gv, rv, knife[k], &nv));
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gs, rs, knife[k], &ns));
@@ -315,7 +349,7 @@ static void run_u(fcm_element_type type)
            what, (long long)fcm_cell_rules_num_pieces(rs), (long long)fcm_cell_rules_num_pieces(rv),
            components(mesh, rs), worst);
   }
-  for (int k = 0; k < 2; k++)
+  for (int k = 0; k < 3; k++)
     fcm_surface_destroy(&knife[k]);
   fcm_cell_rules_destroy(&rv);
   fcm_cell_rules_destroy(&rs);

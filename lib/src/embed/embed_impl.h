@@ -392,7 +392,9 @@ fcm_status fcm__embed_cell_parts(fcm_ctx *ctx, const fcm_geometry *geom, const f
  * reach them, then group them into material pieces: two parts connect when they share a
  * face of positive area that does not lie on a cut triangle; the connected components,
  * numbered by their first part, are the pieces (P->piece, P->num_pieces). The triangles are
- * taken in ascending order; those below first_new are the earlier cuts: the pieces under
+ * taken in ascending order, one cut's after the other's (a surface body's dry parts dropped
+ * and lumps split after each cut), so the parts and pieces do not depend on first_new; those
+ * below first_new are the earlier cuts: the pieces under
  * them alone (what the rules being extended had) are P->parent / P->num_parents, one piece
  * when none of them reaches the cell. P->split_error: how much the new cut's splits (the
  * triangles from first_new on) changed the parts' total volume (rounding only, unless the cut

@@ -789,6 +789,29 @@ cleanup:
   return st;
 }
 
+/* split_parts() by the triangles tris[P->tcand.ids[k0 .. k1)] one cut after the other: the
+ * parts and their order then depend on the cuts alone, not on where first_new divides them (a
+ * surface body's parts are dropped dry and split into lumps after each cut's triangles); *change
+ * (unless NULL): the sum of the cuts' changes. */
+static fcm_status split_cuts(fcm_ctx *ctx, const fcm__embed_cell *cell, const fcm__cut_tri *tris,
+                             size_t k0, size_t k1, fcm__parts *P, double *change)
+{
+  fcm_status st = FCM_OK;
+  if (change) *change = 0.0;
+  for (size_t k = k0; k < k1;) {
+    const int cut = tris[P->tcand.ids[k]].cut;
+    size_t e = k + 1;
+    while (e < k1 && tris[P->tcand.ids[e]].cut == cut)
+      e++;
+    double d = 0.0;
+    FCM_TRY(ctx, split_parts(ctx, cell, tris, k, e, P, change ? &d : NULL));
+    if (change) *change += d;
+    k = e;
+  }
+cleanup:
+  return st;
+}
+
 fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
                                   const fcm__cut_tri *tris, fcm_index first_new, fcm__parts *P)
 {
@@ -797,7 +820,7 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
   double e1 = 0.0;
   while (nold < P->tcand.n && P->tcand.ids[nold] < first_new)
     nold++;
-  FCM_TRY(ctx, split_parts(ctx, cell, tris, 0, nold, P, NULL));
+  FCM_TRY(ctx, split_cuts(ctx, cell, tris, 0, nold, P, NULL));
   if (nold > 0) {
     FCM_TRY(ctx, fcm__embed_parts_components(ctx, cell, tris, nold, P, P->parent, &P->num_parents));
   } else {
@@ -805,7 +828,7 @@ fcm_status fcm__embed_cell_pieces(fcm_ctx *ctx, const fcm__embed_cell *cell,
       P->parent[i] = 0;
     P->num_parents = P->n > 0;
   }
-  FCM_TRY(ctx, split_parts(ctx, cell, tris, nold, P->tcand.n, P, &e1));
+  FCM_TRY(ctx, split_cuts(ctx, cell, tris, nold, P->tcand.n, P, &e1));
   P->split_error = e1;
   FCM_TRY(ctx,
           fcm__embed_parts_components(ctx, cell, tris, P->tcand.n, P, P->piece, &P->num_pieces));

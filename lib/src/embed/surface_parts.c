@@ -22,6 +22,11 @@
 #define PRISM_RTOL     1e-6
 #define FACE_AREA_RTOL 1e-9
 
+/* How far into its part a cut face's polygon is probed for the body (fcm__material_face_inside()),
+ * relative to the cell size: well clear of the cuts' tolerance (1e-9), well inside any part that
+ * matters. */
+#define FACE_PROBE_RTOL 1e-6
+
 struct fcm__material {
   const fcm_geometry *geom;
   const fcm_aabb_tree *tree; /* the boundary triangles' */
@@ -690,7 +695,9 @@ fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__
       m->fpn[np++] = c;
     }
   }
-  /* the polygons the body holds: the winding number at each one's vertex centroid */
+  /* the polygons the body holds: the winding number at each one's vertex centroid, moved
+   * FACE_PROBE_RTOL of the cell into the part (against x's outward normal), so that where the
+   * body's surface lies in the face's plane the polygon goes to the side the body is on */
   for (size_t j = 0; j < np; j++) {
     const double *y = m->fp + SLOT * j;
     const int k = m->fpn[j];
@@ -699,6 +706,8 @@ fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__
     for (int i = 0; i < k; i++)
       for (int d = 0; d < 3; d++)
         c[d] += y[3 * i + d] / k;
+    for (int d = 0; d < 3; d++)
+      c[d] -= FACE_PROBE_RTOL * cell->size * nrm[d];
     for (int v = 0; v < 4; v++) /* a small tet with its corner there */
       for (int d = 0; d < 3; d++)
         T[3 * v + d] = c[d] + (v == d + 1 ? 0.25 * cell->size : 0.0);
