@@ -20,7 +20,8 @@
  * the volume path keeps as two pieces; so must the surface path. A third plane, on the base's
  * face between the prongs, cuts both prongs off the base there: the cell below it is cut again,
  * the one above keeps its pieces (two lumps of one part), and their links must join each
- * lump to its own prong; the cut face on the base's face belongs to the base alone. */
+ * lump to its own prong; the cut face on the base's face belongs to the base alone. A finer
+ * ball in a single cell, cut through, splits one cut face into a hundred polygons. */
 #include "cut_util.h"
 
 #include <math.h>
@@ -358,6 +359,44 @@ static void run_u(fcm_element_type type)
   fcm_mesh_destroy(&mesh);
 }
 
+/* A finer ball (4 cubes per radius) in one Hex8 or Tet4 cell, cut through by a tilted plane:
+ * a cut face meets about a hundred boundary segments and is split into as many polygons, more
+ * than the split's first buffers hold (16 polygons, 64 segments), which grow as it goes. */
+static void run_fine(fcm_element_type type)
+{
+  const char *name = type == FCM_ELEMENT_TET4 ? "fine ball, tet4" : "fine ball, hex8";
+  const double lo[3] = {-1.1, -1.1, -1.1}, hi[3] = {1.1, 1.1, 1.1}, c0[3] = {0, 0, 0};
+  const fcm_index n[3] = {1, 1, 1};
+  fcm_mesh *mesh = NULL;
+  fcm_geometry *gv = NULL, *gs = NULL;
+  fcm_cell_rules *rv = NULL, *rs = NULL, *nv = NULL, *ns = NULL;
+  fcm_surface *knife = NULL;
+  TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
+  TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 1.0, 4, &gv));
+  surface_of(ctx, gv, &gs);
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.min_fraction = 0.0;
+  o.simplify_options.residual_tol = 1e-14;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gv, &o, &rv));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gs, &o, &rs));
+  const double p0[3] = {0.04, -0.03, 0.02}, n0[3] = {0.2, 1, 0.35};
+  const double blo[3] = {-1.05, -1.05, -1.05}, bhi[3] = {1.05, 1.05, 1.05};
+  TEST_OK(ctx, fcm_surface_create_plane(ctx, p0, n0, blo, bhi, &knife));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gv, rv, knife, &nv));
+  TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gs, rs, knife, &ns));
+  const double worst = compare(mesh, nv, ns, name);
+  printf("%s, plane: %lld pieces, %d components, moments agree to %.2e of |K_ref|\n", name,
+         (long long)fcm_cell_rules_num_pieces(ns), components(mesh, ns), worst);
+  fcm_surface_destroy(&knife);
+  fcm_cell_rules_destroy(&nv);
+  fcm_cell_rules_destroy(&ns);
+  fcm_cell_rules_destroy(&rv);
+  fcm_cell_rules_destroy(&rs);
+  fcm_geometry_destroy(&gv);
+  fcm_geometry_destroy(&gs);
+  fcm_mesh_destroy(&mesh);
+}
+
 int main(int argc, char **argv)
 {
   TEST_OK(NULL, fcm_ctx_create(NULL, &ctx));
@@ -370,6 +409,8 @@ int main(int argc, char **argv)
     run(FCM_ELEMENT_TET4);
     run_u(FCM_ELEMENT_HEX8);
     run_u(FCM_ELEMENT_TET4);
+    run_fine(FCM_ELEMENT_HEX8);
+    run_fine(FCM_ELEMENT_TET4);
   }
   fcm_ctx_destroy(&ctx);
   return TEST_RESULT();
