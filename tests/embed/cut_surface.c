@@ -20,9 +20,13 @@
  * the volume path keeps as two pieces; so must the surface path. A third plane, on the base's
  * face between the prongs, cuts both prongs off the base there: the cell below it is cut again,
  * the one above keeps its pieces (two lumps of one part), and their links must join each
- * lump to its own prong; the cut face on the base's face belongs to the base alone. A finer
+ * lump to its own prong; the cut face on the base's face belongs to the base alone. After
+ * each of the U's cuts the embedded surfaces of both paths' spaces move their common points
+ * with corresponding bodies (same_surface_bodies()). A finer
  * ball in a single cell, cut through, splits one cut face into a hundred polygons. */
 #include "cut_util.h"
+#include "fcm/fem.h"
+#include "space_bodies.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -277,6 +281,86 @@ static void run(fcm_element_type type)
   fcm_mesh_destroy(&mesh);
 }
 
+/* The embedded surfaces of the two paths' cut spaces (tiny copies not constrained), each body
+ * translated along x by its own number: a point of both surfaces (the same coordinates, on no
+ * cut face, farther than 1e-6 from the plane of every knife so far: nk planes through kp with
+ * normals kn) follows bodies that correspond one to one between the two spaces, so the
+ * boundary of each lump goes with that lump's piece on both paths. */
+static void same_surface_bodies(const fcm_mesh *mesh, const fcm_geometry *gv,
+                                const fcm_cell_rules *rv, const fcm_geometry *gs,
+                                const fcm_cell_rules *rs, int nk, const double (*kp)[3],
+                                const double (*kn)[3], const char *what)
+{
+  enum { MAX_BODIES = 64 };
+  fcm_space_options so = fcm_space_options_default();
+  so.constrain_ratio = 0.0;
+  fcm_space *sp[2] = {NULL, NULL};
+  fcm_embedded_surface *es[2] = {NULL, NULL};
+  double *disp[2] = {NULL, NULL};
+  int nb[2] = {0, 0};
+  const int nn = fcm_mesh_nodes_per_cell(mesh);
+  for (int k = 0; k < 2; k++) {
+    TEST_OK(ctx, fcm_space_create_embedded_with(ctx, mesh, k ? rs : rv, &so, &sp[k]));
+    TEST_OK(ctx, fcm_embedded_surface_create(sp[k], k ? gs : gv, &es[k]));
+    if (!es[k]) goto done;
+    fcm_index *body = space_element_bodies(sp[k], &nb[k]);
+    double *u = calloc((size_t)fcm_space_num_dofs(sp[k]), sizeof *u);
+    for (fcm_index e = 0; e < fcm_space_num_elements(sp[k]); e++) {
+      const fcm_index *ed = fcm_space_element_dofs(sp[k], e);
+      for (int a = 0; a < nn; a++)
+        u[ed[a]] = (double)(body[e] + 1);
+    }
+    disp[k] = malloc(3 * (size_t)fcm_embedded_surface_num_points(es[k]) * sizeof *disp[k]);
+    TEST_OK(ctx, fcm_embedded_surface_eval(es[k], u, disp[k], NULL));
+    free(u);
+    free(body);
+  }
+  TEST_TRUE_MSG(nb[0] == nb[1] && nb[0] < MAX_BODIES,
+                "%s: %d bodies on the volume path, %d on the surface", what, nb[0], nb[1]);
+  int map[MAX_BODIES], inv[MAX_BODIES];
+  for (int b = 0; b < MAX_BODIES; b++)
+    map[b] = inv[b] = -1;
+  fcm_index matched = 0, crossed = 0;
+  const fcm_index n0 = fcm_embedded_surface_num_points(es[0]),
+                  n1 = fcm_embedded_surface_num_points(es[1]);
+  const double *P0 = fcm_embedded_surface_points(es[0]), *P1 = fcm_embedded_surface_points(es[1]);
+  const int32_t *f0 = fcm_embedded_surface_cut_flags(es[0]),
+                *f1 = fcm_embedded_surface_cut_flags(es[1]);
+  for (fcm_index i = 0; i < n0; i++) {
+    const double *x = P0 + 3 * i;
+    int near = f0[i] != 0;
+    for (int c = 0; c < nk && !near; c++) {
+      const double nl = sqrt(kn[c][0] * kn[c][0] + kn[c][1] * kn[c][1] + kn[c][2] * kn[c][2]);
+      near = fabs((x[0] - kp[c][0]) * kn[c][0] + (x[1] - kp[c][1]) * kn[c][1] +
+                  (x[2] - kp[c][2]) * kn[c][2]) <= 1e-6 * nl;
+    }
+    if (near) continue;
+    fcm_index j = 0;
+    while (j < n1 && (f1[j] || memcmp(P1 + 3 * j, x, 3 * sizeof *x)))
+      j++;
+    if (j == n1) continue;
+    const double d0 = disp[0][3 * i], d1 = disp[1][3 * j];
+    const int b0 = (int)lround(d0) - 1, b1 = (int)lround(d1) - 1;
+    TEST_TRUE_MSG(fabs(d0 - (b0 + 1)) <= 1e-9 && fabs(d1 - (b1 + 1)) <= 1e-9 && b0 >= 0 &&
+                      b0 < nb[0] && b1 >= 0 && b1 < nb[1],
+                  "%s: point %lld follows no one body (%.17g, %.17g)", what, (long long)i, d0, d1);
+    if (!(b0 >= 0 && b0 < MAX_BODIES && b1 >= 0 && b1 < MAX_BODIES)) continue;
+    matched++;
+    if (map[b0] < 0 && inv[b1] < 0) map[b0] = b1, inv[b1] = b0;
+    crossed += map[b0] != b1;
+  }
+  TEST_TRUE_MSG(matched > 0 && crossed == 0,
+                "%s: of %lld surface points of both paths, %lld follow bodies that do not "
+                "correspond",
+                what, (long long)matched, (long long)crossed);
+done:
+  for (int k = 0; k < 2; k++) {
+    fcm_embedded_surface_destroy(&es[k]);
+    fcm_space_destroy(&sp[k]);
+    free(disp[k]);
+  }
+}
+
 /* The box [0.03, 3.01] x [0.02, 2.04] x [0.01, 0.97] of 3 x 2 x 1 Kuhn-split cubes without
  * cube (1, 1, 0): a U with prongs along y from y = 1.03 at x < 1.02 and x > 2.02. */
 static void u_body(fcm_geometry **gv)
@@ -335,6 +419,8 @@ static void run_u(fcm_element_type type)
   TEST_OK(ctx, fcm_surface_create_plane(ctx, p2, n2, blo, bhi, &knife[2]));
   const char *names[3] = {"plane across both prongs", "crack across one prong",
                           "plane on the base's face"};
+  const double kp[3][3] = {{p0[0], p0[1], p0[2]}, {rc[0], rc[1], rc[2]}, {p2[0], p2[1], p2[2]}},
+               kn[3][3] = {{n0[0], n0[1], n0[2]}, {rn[0], rn[1], rn[2]}, {n2[0], n2[1], n2[2]}};
   for (int k = 0; k < 3; k++) {
     fcm_cell_rules *nv = NULL, *ns = NULL;
     TEST_OK(ctx, fcm_cell_rules_create_cut(ctx, mesh, gv, rv, knife[k], &nv));
@@ -345,6 +431,7 @@ static void run_u(fcm_element_type type)
     char what[64];
     snprintf(what, sizeof what, "%s, %s", name, names[k]);
     const double worst = compare(mesh, rv, rs, what);
+    same_surface_bodies(mesh, gv, rv, gs, rs, k + 1, kp, kn, what);
     printf("%s: %lld pieces (volume path %lld), %d components, moments agree to %.2e of "
            "|K_ref|\n",
            what, (long long)fcm_cell_rules_num_pieces(rs), (long long)fcm_cell_rules_num_pieces(rv),

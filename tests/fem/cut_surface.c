@@ -23,6 +23,7 @@
 #include "fcm/fcm.h"
 #include "fem/fem_impl.h"
 #include "fem_util.h"
+#include "space_bodies.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -39,46 +40,6 @@ static fcm_element_type parse(const char *s)
   for (int i = 0; i < 4; i++)
     if (!strcmp(s, names[i])) return types[i];
   return FCM_ELEMENT_COUNT;
-}
-
-static fcm_index find(fcm_index *uf, fcm_index a)
-{
-  while (uf[a] != a)
-    a = uf[a] = uf[uf[a]];
-  return a;
-}
-
-/* Body of every element (0 .. *count-1): elements sharing a DOF copy are one body. */
-static fcm_index *element_bodies(const fcm_space *s, int *count)
-{
-  const fcm_index ne = fcm_space_num_elements(s), nd = fcm_space_num_dofs(s);
-  const int nn = fcm_mesh_nodes_per_cell(fcm_space_mesh(s));
-  fcm_index *uf = malloc(sizeof *uf * (size_t)ne), *first = malloc(sizeof *first * (size_t)nd);
-  fcm_index *label = malloc(sizeof *label * (size_t)ne), *root = malloc(sizeof *root * (size_t)ne);
-  for (fcm_index e = 0; e < ne; e++)
-    uf[e] = e, root[e] = -1;
-  for (fcm_index k = 0; k < nd; k++)
-    first[k] = -1;
-  for (fcm_index e = 0; e < ne; e++) {
-    const fcm_index *ed = fcm_space_element_dofs(s, e);
-    for (int a = 0; a < nn; a++) {
-      if (first[ed[a]] < 0) {
-        first[ed[a]] = e;
-        continue;
-      }
-      const fcm_index x = find(uf, e), y = find(uf, first[ed[a]]);
-      if (x != y) uf[x > y ? x : y] = x < y ? x : y;
-    }
-  }
-  int n = 0;
-  for (fcm_index e = 0; e < ne; e++) {
-    const fcm_index r = find(uf, e);
-    if (root[r] < 0) root[r] = n++;
-    label[e] = root[r];
-  }
-  *count = n;
-  free(uf), free(first), free(root);
-  return label;
 }
 
 /* The rigid motion of body b: x -> Q_b x + t_b (rotation about a fixed axis; none when
@@ -124,7 +85,7 @@ static void check(const fcm_space *s, const fcm_embedded_surface *es, const fcm_
                   int ncut, const double (*pp)[3], const double (*pn)[3], double h, int rotate)
 {
   int nb = 0;
-  fcm_index *body = element_bodies(s, &nb);
+  fcm_index *body = space_element_bodies(s, &nb);
   TEST_TRUE(nb == fcm_space_num_bodies(s) && nb >= ncut + 1 && nb <= MAX_BODIES);
   if (nb > MAX_BODIES) nb = MAX_BODIES;
   double Q[MAX_BODIES][9], T[MAX_BODIES][3];
