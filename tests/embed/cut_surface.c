@@ -23,7 +23,7 @@
  * lump to its own prong; the cut face on the base's face belongs to the base alone. After
  * each of the U's cuts the embedded surfaces of both paths' spaces move their common points
  * with corresponding bodies (same_surface_bodies()). A finer
- * ball in a single cell, cut through, splits one cut face into a hundred polygons. */
+ * ball in one cell, cut through, splits one cut face into a hundred polygons. */
 #include "cut_util.h"
 #include "fcm/fem.h"
 #include "space_bodies.h"
@@ -340,7 +340,8 @@ static void same_surface_bodies(const fcm_mesh *mesh, const fcm_geometry *gv,
       j++;
     if (j == n1) continue;
     const double d0 = disp[0][3 * i], d1 = disp[1][3 * j];
-    const int b0 = (int)lround(d0) - 1, b1 = (int)lround(d1) - 1;
+    const int b0 = fabs(d0) < MAX_BODIES + 1.0 ? (int)lround(d0) - 1 : -1,
+              b1 = fabs(d1) < MAX_BODIES + 1.0 ? (int)lround(d1) - 1 : -1;
     TEST_TRUE_MSG(fabs(d0 - (b0 + 1)) <= 1e-9 && fabs(d1 - (b1 + 1)) <= 1e-9 && b0 >= 0 &&
                       b0 < nb[0] && b1 >= 0 && b1 < nb[1],
                   "%s: point %lld follows no one body (%.17g, %.17g)", what, (long long)i, d0, d1);
@@ -446,9 +447,11 @@ static void run_u(fcm_element_type type)
   fcm_mesh_destroy(&mesh);
 }
 
-/* A finer ball (4 cubes per radius) in one Hex8 or Tet4 cell, cut through by a tilted plane:
- * a cut face meets about a hundred boundary segments and is split into as many polygons, more
- * than the split's first buffers hold (16 polygons, 64 segments), which grow as it goes. */
+/* A finer ball (4 cubes per radius) in one Hex8 cell (or the six Tet4 cells of one cube), cut
+ * through by a tilted plane: a cut face of the Hex8 cell meets about a hundred boundary
+ * segments and is split into as many polygons, more than the split's first buffers hold (16
+ * polygons, 64 segments), which grow as it goes (the faces' agreement with the volume path
+ * checks what the growth copies). */
 static void run_fine(fcm_element_type type)
 {
   const char *name = type == FCM_ELEMENT_TET4 ? "fine ball, tet4" : "fine ball, hex8";

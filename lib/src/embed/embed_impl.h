@@ -820,8 +820,10 @@ int fcm__material_on_face(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell 
 /* The part of the planar convex polygon x (n vertices, physical) on a face of cell inside the
  * body, fanned into b with x's orientation: x is split along the lines where the boundary
  * triangles near it cross its plane, into convex polygons that no boundary crosses, and those
- * the body holds (an inside test at each one's vertex centroid) are kept. Polygons of no
- * more area than 1e-9 of the cell size squared are left out. */
+ * the body holds (an inside test at each one's vertex centroid; where a boundary triangle
+ * lies in the plane, moved 1e-8 of the cell size into the part, x's outward normal pointing
+ * out of it) are kept. Polygons of no more area than 1e-9 of the cell size squared are left
+ * out. */
 fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__embed_cell *cell,
                                      const double *x, int n, fcm__tribuf *b);
 

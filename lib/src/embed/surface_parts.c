@@ -22,10 +22,10 @@
 #define PRISM_RTOL     1e-6
 #define FACE_AREA_RTOL 1e-9
 
-/* How far into its part a cut face's polygon is probed for the body (fcm__material_face_inside()),
- * relative to the cell size: well clear of the cuts' tolerance (1e-9), well inside any part that
- * matters. */
-#define FACE_PROBE_RTOL 1e-6
+/* How far into its part a cut face's polygon is probed for the body where a boundary triangle
+ * lies in the face's plane (fcm__material_face_inside()), relative to the cell size: ten times
+ * the cuts' tolerance (1e-9), within which a triangle counts as in the plane. */
+#define FACE_PROBE_RTOL 1e-8
 
 struct fcm__material {
   const fcm_geometry *geom;
@@ -654,10 +654,14 @@ fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__
   FCM_TRY(ctx, fcm__geom_tree_query(ctx, m->tree, lo, hi, &m->buf));
   FCM_TRY(ctx, face_room(ctx, m, 0, 1, m->buf.n));
   size_t ns = 0;
+  int flat = 0; /* a boundary triangle lies in the plane */
   for (size_t k = 0; k < m->buf.n; k++) {
     const fcm_index *t = G->tris + 3 * m->buf.ids[k];
-    ns += (size_t)tri_segment(G->coords + 3 * t[0], G->coords + 3 * t[1], G->coords + 3 * t[2], nrm,
-                              d0, tol, m->seg + 6 * ns, m->seg + 6 * ns + 3);
+    const double *ta = G->coords + 3 * t[0], *tb = G->coords + 3 * t[1], *tc = G->coords + 3 * t[2];
+    ns += (size_t)tri_segment(ta, tb, tc, nrm, d0, tol, m->seg + 6 * ns, m->seg + 6 * ns + 3);
+    flat = flat ||
+           (fabs(fcm__vec3_dot(nrm, ta) - d0) <= tol && fabs(fcm__vec3_dot(nrm, tb) - d0) <= tol &&
+            fabs(fcm__vec3_dot(nrm, tc) - d0) <= tol);
   }
   /* x split along each segment's line where the segment runs through a polygon: no segment
    * crosses the polygons left, each lies wholly inside the body or wholly outside */
@@ -695,9 +699,10 @@ fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__
       m->fpn[np++] = c;
     }
   }
-  /* the polygons the body holds: the winding number at each one's vertex centroid, moved
-   * FACE_PROBE_RTOL of the cell into the part (against x's outward normal), so that where the
-   * body's surface lies in the face's plane the polygon goes to the side the body is on */
+  /* the polygons the body holds: the winding number at each one's vertex centroid; where the
+   * body's surface lies in the face's plane, moved FACE_PROBE_RTOL of the cell into the part
+   * (against x's outward normal), so that the polygon goes to the side the body is on */
+  const double probe = flat ? FACE_PROBE_RTOL * cell->size : 0.0;
   for (size_t j = 0; j < np; j++) {
     const double *y = m->fp + SLOT * j;
     const int k = m->fpn[j];
@@ -707,7 +712,7 @@ fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__
       for (int d = 0; d < 3; d++)
         c[d] += y[3 * i + d] / k;
     for (int d = 0; d < 3; d++)
-      c[d] -= FACE_PROBE_RTOL * cell->size * nrm[d];
+      c[d] -= probe * nrm[d];
     for (int v = 0; v < 4; v++) /* a small tet with its corner there */
       for (int d = 0; d < 3; d++)
         T[3 * v + d] = c[d] + (v == d + 1 ? 0.25 * cell->size : 0.0);
