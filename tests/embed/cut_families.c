@@ -38,6 +38,7 @@
 #include "fcm/fcm.h"
 #include "test.h"
 #include "la/vec3.h"
+#include "space_bodies.h"
 
 #define MAX_PLANES 3
 #define NELEM      4
@@ -336,49 +337,6 @@ static void count_case(fcm_element_type type, const char *what, int failed)
   fam_failed[t][f] += failed;
 }
 
-static fcm_index root(fcm_index *uf, fcm_index x)
-{
-  while (uf[x] != x)
-    x = uf[x] = uf[uf[x]];
-  return x;
-}
-
-/* Bodies of a space: elements joined through shared DOF copies; *nb of them, the body of
- * each element (0 .. nb-1) returned (malloc'ed). */
-static fcm_index *space_bodies(const fcm_space *sp, int *nb)
-{
-  const fcm_index ne = fcm_space_num_elements(sp), nc = fcm_space_num_dofs(sp) / 3;
-  const int nn = fcm_mesh_nodes_per_cell(fcm_space_mesh(sp));
-  fcm_index *uf = malloc((size_t)ne * sizeof *uf), *first = malloc((size_t)nc * sizeof *first);
-  fcm_index *num = malloc((size_t)ne * sizeof *num);
-  for (fcm_index e = 0; e < ne; e++)
-    uf[e] = e, num[e] = -1;
-  for (fcm_index k = 0; k < nc; k++)
-    first[k] = -1;
-  for (fcm_index e = 0; e < ne; e++) {
-    const fcm_index *ed = fcm_space_element_dofs(sp, e);
-    for (int a = 0; a < nn; a++) {
-      const fcm_index k = ed[a] / 3;
-      if (first[k] < 0) {
-        first[k] = e;
-        continue;
-      }
-      const fcm_index x = root(uf, e), y = root(uf, first[k]);
-      if (x != y) uf[x > y ? x : y] = x < y ? x : y;
-    }
-  }
-  int n = 0;
-  for (fcm_index e = 0; e < ne; e++) {
-    const fcm_index r = root(uf, e);
-    if (num[r] < 0) num[r] = n++;
-    num[e] = num[r];
-  }
-  free(uf);
-  free(first);
-  *nb = n;
-  return num;
-}
-
 /* The side range [*lo, *hi] of plane pl over the authentic stiffness points of piece p. */
 static void piece_range(const fcm_mesh *mesh, const fcm_cell_rules *r, fcm_index p, const plane *pl,
                         double *lo, double *hi)
@@ -465,7 +423,7 @@ static void run_case(const body *b, fcm_element_type type, const setup *S, const
     /* bodies: one side of every plane each, as many as the reference */
     TEST_OK(ctx, fcm_space_create_embedded(ctx, S->mesh, next, &sp));
     int nb = 0;
-    fcm_index *eb = sp ? space_bodies(sp, &nb) : NULL;
+    fcm_index *eb = sp ? space_element_bodies(sp, &nb) : NULL;
     double(*range)[MAX_PLANES][2] = calloc((size_t)nb + 1, sizeof *range);
     for (int i = 0; i < nb; i++)
       for (int j = 0; j <= k; j++)

@@ -201,12 +201,7 @@ static void run(fcm_element_type type, int nc)
   fcm_cell_rules *rv = NULL, *rs = NULL;
   TEST_OK(ctx, fcm_mesh_create_box(ctx, type, lo, hi, n, &mesh));
   TEST_OK(ctx, fcm_geometry_create_ball(ctx, c0, 1.0, 2, &gv));
-  surface_of(ctx, gv, &gs);
-  fcm_cell_rules_options o = fcm_cell_rules_options_default();
-  o.min_fraction = 0.0;
-  o.simplify_options.residual_tol = 1e-14;
-  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gv, &o, &rv));
-  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gs, &o, &rs));
+  both_paths(ctx, mesh, gv, &gs, &rv, &rs);
   /* a tilted plane through the middle; a plane 1e-4 h beyond the grid plane y = lo + 2 h,
    * tilted by 1e-3; a cap near the top */
   const knife K[NUM_KNIVES] = {{{0.07, 0.03, -0.05}, {1, 0.3, 0.2}},

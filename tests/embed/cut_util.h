@@ -65,4 +65,18 @@ static inline void surface_of(fcm_ctx *ctx, const fcm_geometry *g, fcm_geometry 
   free(y);
 }
 
+/* The rules of both paths on mesh: the volume geometry gv's (*rv) and those of its boundary as
+ * a surface geometry (*gs, *rs), every piece kept (min_fraction 0) and fitted to 1e-14
+ * relative residual of its moments. */
+static inline void both_paths(fcm_ctx *ctx, const fcm_mesh *mesh, const fcm_geometry *gv,
+                              fcm_geometry **gs, fcm_cell_rules **rv, fcm_cell_rules **rs)
+{
+  surface_of(ctx, gv, gs);
+  fcm_cell_rules_options o = fcm_cell_rules_options_default();
+  o.min_fraction = 0.0;
+  o.simplify_options.residual_tol = 1e-14;
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, gv, &o, rv));
+  TEST_OK(ctx, fcm_cell_rules_create(ctx, mesh, *gs, &o, rs));
+}
+
 #endif
