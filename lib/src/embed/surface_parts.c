@@ -544,9 +544,9 @@ cleanup:
 
 /* Where boundary triangle (a, b, c) crosses the plane nrm . y = d: its segment (p, q); 0 when
  * it does not cross it along a segment longer than tol (vertices within tol of the plane count
- * as on it; a triangle in the plane crosses nothing). */
+ * as on it; a triangle in the plane crosses nothing, and sets *flat). */
 static int tri_segment(const double *a, const double *b, const double *c, const double nrm[3],
-                       double d, double tol, double p[3], double q[3])
+                       double d, double tol, double p[3], double q[3], int *flat)
 {
   const double *v[3] = {a, b, c};
   double s[3], pt[3][3];
@@ -557,6 +557,7 @@ static int tri_segment(const double *a, const double *b, const double *c, const 
     pos += s[i] > tol;
     neg += s[i] < -tol;
   }
+  if (on == 3) *flat = 1;
   if (on == 3 || (on + pos == 3 && on < 2) || (on + neg == 3 && on < 2)) return 0;
   for (int i = 0; i < 3; i++) {
     const int j = (i + 1) % 3;
@@ -657,11 +658,8 @@ fcm_status fcm__material_face_inside(fcm_ctx *ctx, fcm__material *m, const fcm__
   int flat = 0; /* a boundary triangle lies in the plane */
   for (size_t k = 0; k < m->buf.n; k++) {
     const fcm_index *t = G->tris + 3 * m->buf.ids[k];
-    const double *ta = G->coords + 3 * t[0], *tb = G->coords + 3 * t[1], *tc = G->coords + 3 * t[2];
-    ns += (size_t)tri_segment(ta, tb, tc, nrm, d0, tol, m->seg + 6 * ns, m->seg + 6 * ns + 3);
-    flat = flat ||
-           (fabs(fcm__vec3_dot(nrm, ta) - d0) <= tol && fabs(fcm__vec3_dot(nrm, tb) - d0) <= tol &&
-            fabs(fcm__vec3_dot(nrm, tc) - d0) <= tol);
+    ns += (size_t)tri_segment(G->coords + 3 * t[0], G->coords + 3 * t[1], G->coords + 3 * t[2], nrm,
+                              d0, tol, m->seg + 6 * ns, m->seg + 6 * ns + 3, &flat);
   }
   /* x split along each segment's line where the segment runs through a polygon: no segment
    * crosses the polygons left, each lies wholly inside the body or wholly outside */
