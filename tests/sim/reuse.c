@@ -4,7 +4,8 @@
  * factorizations and tangent assemblies; every iteration solved with the kept factorization
  * either contracts the residual by reuse_contraction or makes the next iteration factor anew
  * (a contraction no iteration reaches leaves at most one kept solve per factorization); static
- * steps and the Krylov solvers never reuse; out-of-range options are refused at setup. */
+ * steps, the fixed-iteration rule and the Krylov solvers never reuse; out-of-range options are
+ * refused at setup. */
 #include "sim_util.h"
 
 #include <math.h>
@@ -129,6 +130,27 @@ int main(int argc, char **argv)
     TEST_TRUE(nb.reused > 0);
   }
 
+  /* the fixed-iteration rule never reuses: each step's one iteration assembles and factors
+   * anew, so reuse_factorization changes no bit of the run */
+  {
+    fcm_integrator_options o = options(1, 0.25);
+    o.newton_fixed_iterations = 1;
+    fcm_integrator *on = make(ctx, space, &mat, nfix, fix, &o, -9.81);
+    o.reuse_factorization = 0;
+    fcm_integrator *off = make(ctx, space, &mat, nfix, fix, &o, -9.81);
+    for (int s = 0; on && off && s < STEPS; s++) {
+      fcm_step_info a, b;
+      TEST_OK(ctx, fcm_integrator_step(on, &a));
+      TEST_OK(ctx, fcm_integrator_step(off, &b));
+      TEST_TRUE(a.newton_iterations == 1 && a.reused_factorizations == 0 && a.factorizations == 1 &&
+                a.tangent_assemblies == 1);
+      TEST_TRUE(a.residual == b.residual);
+      TEST_TRUE(!memcmp(fcm_integrator_displacement(on), fcm_integrator_displacement(off),
+                        sizeof(double) * (size_t)n));
+    }
+    fcm_integrator_destroy(&on);
+    fcm_integrator_destroy(&off);
+  }
   /* static steps (no mass to keep the iterates close) never reuse */
   {
     fcm_integrator_options o = options(1, 0.25);

@@ -204,12 +204,15 @@ typedef struct fcm_integrator_options {
                                  iteration with the factorization of an earlier iterate or step
                                  (dropped by fcm_integrator_drop_factorization(), a change of
                                  dt, constraints or damping, a failed step), kept while every
-                               iteration solved  with it reduces the residual norm by
-                               reuse_contraction or more  (modified Newton: iterations without a
-                               tangent assembly or a  factorization; the stopping rule is unchanged);
-                               an iteration  that falls short, backtracks or meets a non-descent
-                               direction  makes the next one factor anew. 0: a new tangent and
-                                 factorization every iteration ["newton.reuse_factorization"] */
+                                 iteration solved with it reduces the residual norm by
+                                 reuse_contraction or more (modified Newton: iterations without
+                                 a tangent assembly or a factorization; the stopping rule is
+                                 unchanged); an iteration that falls short, backtracks or meets
+                                 a non-descent direction makes the next one factor anew. Unused
+                                 under newton_fixed_iterations, whose steps keep the residual
+                                 their last iteration reaches: there every iteration factors
+                                 anew. 0: a new tangent and factorization every iteration
+                                 ["newton.reuse_factorization"] */
   double reuse_contraction; /**< in (0, 1) (default 0.25) ["newton.reuse_contraction"] */
   /** Interactive steps (the graphics use; 0, the default, is the accurate rule above): N >= 1
    * makes every (sub)step run N Newton iterations and accept the iterate it reaches whatever
