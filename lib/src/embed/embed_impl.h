@@ -794,7 +794,7 @@ fcm_status fcm__embed_inside_column(fcm_ctx *ctx, const fcm_geometry *g, const f
                                     fcm__crossings *cr);
 
 /* ---------------------------------------------------------------- parts of a surface body
- * (surface_parts.c) */
+ * (surface_parts.c; its cut faces: surface_faces.c) */
 
 /* The body of a geometry without a volume mesh (its closed boundary) and the scratch of the
  * material tests on it; one per thread. */
