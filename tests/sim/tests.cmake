@@ -87,7 +87,8 @@ endforeach()
 # stagnating Krylov solve is the step's reason.
 fcm_add_test(sim_rigid_modes tests/sim/rigid_modes.c)
 # Modified Newton on a kept factorization: the same states as full Newton with far fewer
-# factorizations; the contraction rule; static steps and Krylov solvers never reuse.
+# factorizations; the contraction rule; static steps, the fixed-iteration rule and Krylov solvers
+# never reuse.
 foreach(el hex8 tet10)
   fcm_add_test(sim_reuse_${el} tests/sim/reuse.c ARGS ${el})
 endforeach()

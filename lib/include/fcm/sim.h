@@ -210,9 +210,9 @@ typedef struct fcm_integrator_options {
                                  unchanged); an iteration that falls short, backtracks or meets
                                  a non-descent direction makes the next one factor anew. Unused
                                  under newton_fixed_iterations, whose steps keep the residual
-                                 their last iteration reaches: there every iteration factors
-                                 anew. 0: a new tangent and factorization every iteration
-                                 ["newton.reuse_factorization"] */
+                                 their last iteration reaches: there every iteration of a
+                                 nonlinear material factors anew. 0: a new tangent and
+                                 factorization every iteration ["newton.reuse_factorization"] */
   double reuse_contraction; /**< in (0, 1) (default 0.25) ["newton.reuse_contraction"] */
   /** Interactive steps (the graphics use; 0, the default, is the accurate rule above): N >= 1
    * makes every (sub)step run N Newton iterations and accept the iterate it reaches whatever
@@ -222,9 +222,9 @@ typedef struct fcm_integrator_options {
    * FCM_STEP_CONVERGED: a further update would be round-off). A failed line search, a failed
    * linear solve or NaN still fail the (sub)step, which is then halved as usual. The last
    * iteration assembles no tangent for a next one. Combine with multigrid_fixed_cycles for
-   * the cost of Dick et al. (2011): 1 iteration of 3 V-cycles. newton_max_iterations is then
-   * unused. A predictor iteration (prescribed motion) counts as one. In [0, 10^6]
-   * ["newton.fixed_iterations"] */
+   * the cost of Dick et al. (2011): 1 iteration of 3 V-cycles. newton_max_iterations and
+   * reuse_factorization are then unused. A predictor iteration (prescribed motion) counts as
+   * one. In [0, 10^6] ["newton.fixed_iterations"] */
   int newton_fixed_iterations;
   int cut_reuse; /**< what fcm_integrator_create_cut() keeps of this integrator, a sum of
                       fcm_cut_reuse flags (default 0: the new integrator is built from scratch).

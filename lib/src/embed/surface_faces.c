@@ -2,7 +2,7 @@
  * the body does not fill the part, is split along the lines where the boundary triangles near
  * it cross its plane, and only the polygons inside the body are kept, so that the cut face ends
  * at the body's surface (fcm__material_face_inside()). */
-#include "embed/material_impl.h"
+#include "embed/surface_impl.h"
 #include "la/vec3.h"
 
 #include <math.h>

@@ -7,8 +7,9 @@
  * faces holds material: the body's volume in a thin prism on the overlap. So the pieces are
  * the components of the material as the volume mesh's parts give them. A part that holds two
  * separate lumps of the body is replaced by its pieces inside the body (split by the boundary
- * triangles), which join only within a lump. */
-#include "embed/material_impl.h"
+ * triangles), which join only within a lump. The parts' cut faces, which end at the body's
+ * surface: surface_faces.c. */
+#include "embed/surface_impl.h"
 #include "element/element_impl.h"
 #include "la/mat3.h"
 #include "la/vec3.h"
@@ -20,6 +21,9 @@
 /* The prism's half-height on a face, relative to the cell size: far above the surface moments'
  * rounding (1e-15 of the prism). */
 #define PRISM_RTOL 1e-6
+
+/* A part whose material is within this fraction of its volume lies wholly inside the body. */
+#define FULL_RTOL 1e-12
 
 fcm_status fcm__material_create(fcm_ctx *ctx, const fcm_geometry *geom, fcm__material **out)
 {
@@ -63,9 +67,6 @@ fcm_status fcm__material_status(fcm__material *m)
   m->st = FCM_OK;
   return st;
 }
-
-/* A part whose material is within this fraction of its volume lies wholly inside the body. */
-#define FULL_RTOL 1e-12
 
 void fcm__material_tet_cell(const double *T, fcm_index id, fcm__embed_cell *k)
 {

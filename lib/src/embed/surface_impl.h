@@ -1,8 +1,8 @@
 /* embed module, private to the files on a body given by its closed boundary alone: the body
  * and the scratch of its material tests (fcm__material, embed_impl.h), shared by its cells'
  * parts (surface_parts.c) and the cut faces that end at its surface (surface_faces.c). */
-#ifndef FCM_EMBED_MATERIAL_IMPL_H
-#define FCM_EMBED_MATERIAL_IMPL_H
+#ifndef FCM_EMBED_SURFACE_IMPL_H
+#define FCM_EMBED_SURFACE_IMPL_H
 
 #include "embed/embed_impl.h"
 
@@ -35,4 +35,4 @@ struct fcm__material {
 /* Tet (c, a, b, e) (12 doubles) as an affine Tet4 cell of cell id: node 0 at xi = 0. */
 void fcm__material_tet_cell(const double *T, fcm_index id, fcm__embed_cell *k);
 
-#endif
+#endif /* FCM_EMBED_SURFACE_IMPL_H */
