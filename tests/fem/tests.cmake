@@ -64,9 +64,9 @@ foreach(el tet4 tet10 hex8 hex20)
 endforeach()
 # The embedded surface of a ball cut once, then twice: with every body moved rigidly, each
 # triangle (boundary, split part, cut face) follows one body (edges keep their length), the
-# parts cover the boundary's area, each lies on one side of every cut plane. The hexahedra's
-# runs take 500 to 760 s in the sanitizer build (60 to 100 s without): there they are labelled
-# slow, outside the default run, which keeps the simplices' runs (240 to 380 s).
+# parts cover the boundary's area, each lies on one side of every cut plane. In the sanitizer
+# build the hexahedra's runs take about twice the simplices' (near the 600 s timeout): there they
+# are labelled slow, outside the default run, which keeps the simplices'.
 foreach(el tet4 tet10 hex8 hex20)
   set(labels unit)
   if(FCM_SANITIZE AND el MATCHES "^hex")

@@ -340,8 +340,7 @@ cleanup:
  * every iteration solved with it contracted enough. Not under the fixed-iteration rule: its
  * steps end where their iterations do, so an iteration on an older tangent leaves its larger
  * residual in the state, and these errors add up from step to step until the run diverges
- * (a thin cut slab under gravity: residuals 6 to 54 times those of fresh iterations, inverted
- * points after 23 steps). */
+ * (lib/docs/cutting.md, "Fixed iterations factor anew"). */
 static int kept_usable(const fcm_integrator *I, double h)
 {
   return I->opts.reuse_factorization && I->opts.newton_fixed_iterations == 0 && !I->linear &&
