@@ -84,6 +84,20 @@ static void snh(double mu_s, double lambda_s, const double s[3], spectral *d)
   }
 }
 
+/* Whether the symmetric 3x3 A is positive definite: the pivots of its LDL^T are positive
+ * (false for NaN). The clamp of the eigenvalues leaves such a block as it is, so its
+ * eigen-decomposition is skipped. */
+static int positive_definite3(const double A[9])
+{
+  const double d0 = A[0];
+  if (!(d0 > 0.0)) return 0;
+  const double l1 = A[3] / d0, l2 = A[6] / d0;
+  const double d1 = A[4] - l1 * A[3];
+  if (!(d1 > 0.0)) return 0;
+  const double e = A[7] - l2 * A[3];
+  return A[8] - l2 * A[6] - e * e / d1 > 0.0;
+}
+
 /* Clamp at 0, keeping NaN. */
 static double clamp0(double v)
 {
@@ -122,14 +136,16 @@ void fcm__material_eval_svd(const fcm_material_params *p, const double F[9], dou
   double H[9], dg[3], off[3];
   memcpy(H, d.H, sizeof H);
   if (p->project_psd) {
-    double h[3], Q[9];
-    fcm__mat3_sym_eig(d.H, h, Q);
-    for (int k = 0; k < 3; k++)
-      h[k] = clamp0(h[k]);
-    for (int a = 0; a < 3; a++)
-      for (int b = 0; b < 3; b++)
-        H[3 * a + b] = Q[3 * a] * h[0] * Q[3 * b] + Q[3 * a + 1] * h[1] * Q[3 * b + 1] +
-                       Q[3 * a + 2] * h[2] * Q[3 * b + 2];
+    if (!positive_definite3(d.H)) {
+      double h[3], Q[9];
+      fcm__mat3_sym_eig(d.H, h, Q);
+      for (int k = 0; k < 3; k++)
+        h[k] = clamp0(h[k]);
+      for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+          H[3 * a + b] = Q[3 * a] * h[0] * Q[3 * b] + Q[3 * a + 1] * h[1] * Q[3 * b + 1] +
+                         Q[3 * a + 2] * h[2] * Q[3 * b + 2];
+    }
     for (int m = 0; m < 3; m++) {
       d.lf[m] = clamp0(d.lf[m]);
       d.lt[m] = clamp0(d.lt[m]);
